@@ -1,0 +1,62 @@
+"""Command line: ``jointcal <subcommand> ...`` (also ``python -m jointcal.cli``).
+
+Each subcommand is one ``_cmd_<name>(args) -> int`` function plus one entry in
+`build_parser`. A `~jointcal.io.CampaignError` prints ``jointcal: <message>`` to
+stderr and exits with status 2, having written nothing.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+
+from jointcal import __version__
+from jointcal.io import CampaignError, ingest_campaign, write_csv_atomic
+
+__all__ = ["build_parser", "main"]
+
+
+def _cmd_ingest(args: argparse.Namespace) -> int:
+    """Validate a campaign folder and write one row per run to OUT_CSV."""
+    runs = ingest_campaign(args.campaign_dir, on_data_problem=args.on_data_problem)
+    write_csv_atomic(runs, args.out_csv)
+    flagged = int((runs["flags"] != "").sum())
+    print(f"jointcal: wrote {len(runs)} runs ({flagged} flagged) to {args.out_csv}")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser with every subcommand (each sets ``func``)."""
+    parser = argparse.ArgumentParser(
+        prog="jointcal", description="Calibrate Iwan joint models from swept-sine shaker tests.")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    p = sub.add_parser("ingest", help="validate a campaign folder and tabulate its runs",
+                       description=_cmd_ingest.__doc__)
+    p.add_argument("campaign_dir", metavar="CAMPAIGN_DIR", help="folder holding manifest.csv and the run files")
+    p.add_argument("out_csv", metavar="OUT_CSV", help="table to write (one row per run)")
+    p.add_argument("--on-data-problem", choices=("error", "flag"), default="error",
+                   help="NaN/inf values and clipping: fail (default) or record them in the flags column")
+    p.set_defaults(func=_cmd_ingest)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; return the exit status (0 ok, 2 bad campaign or usage).
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        Arguments without the program name; ``sys.argv[1:]`` when None.
+    """
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except CampaignError as exc:
+        print(f"jointcal: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

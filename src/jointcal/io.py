@@ -1,0 +1,238 @@
+"""Raw-data contract: read and validate a swept-sine campaign; write files atomically.
+
+A campaign folder holds ``manifest.csv`` (one row per run) and one record per run
+(``.csv``, ``.csv.gz`` or MATLAB ``.mat``) with the columns ``time_s`` (s),
+``base_accel_g`` (g) or, for force-driven tests, ``force_lbf`` (lbf), and
+``response_accel_g`` (g); 1 g = 386.089 in/s^2. ``raw_data/README.md`` states the
+contract for people; every violation raises `CampaignError` with one sentence that
+names the file, the problem and the fix. File I/O of the package lives here (the
+checks and writers are in private helper modules and re-exported).
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import scipy.io
+from numpy.typing import NDArray
+
+from jointcal._atomic import write_bytes_atomic, write_csv_atomic, write_json_atomic, write_run
+from jointcal._checks import validate_run
+from jointcal._contract import (
+    LEVEL, POSITIVE, REFERENCE, RESPONSE, TEXT, TIME, CampaignError, CampaignWarning,
+    OnDataProblem, excitation_of, fail,
+)
+
+__all__ = [
+    "CampaignError", "CampaignWarning", "read_manifest", "read_run", "validate_run",
+    "ingest_campaign", "write_bytes_atomic", "write_csv_atomic", "write_json_atomic",
+    "write_run",
+]
+
+
+def read_manifest(path: str | os.PathLike[str]) -> pd.DataFrame:
+    """Read and validate a campaign's ``manifest.csv``.
+
+    Parameters
+    ----------
+    path : path-like
+        The manifest file. Columns: ``run_id``, ``assembly``, ``sequence`` (order of
+        the run within its assembly, integer >= 1), ``level_g`` (base acceleration
+        amplitude, g) or ``level_lbf`` (force amplitude, lbf), ``direction``
+        (``up``/``down``), ``f_start_hz``, ``f_stop_hz`` (Hz),
+        ``sweep_rate_hz_per_s`` (Hz/s), ``sample_rate_hz`` (Hz) and ``file`` (relative
+        to the manifest's folder). Extra columns are kept.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per run in file order; numbers as float64 (``sequence`` int64),
+        text stripped, ``direction`` lower-case.
+
+    Raises
+    ------
+    CampaignError
+        Missing file or column, empty or non-numeric cell, non-positive rate or
+        frequency, band inconsistent with the direction or above Nyquist, or a
+        duplicated ``run_id``, ``file`` or (``assembly``, ``sequence``).
+    """
+    path = Path(path)
+    if not path.is_file():
+        fail(path, "the manifest does not exist", "put manifest.csv (one row per run) in the campaign folder")
+    try:
+        raw = pd.read_csv(path, dtype=str, keep_default_na=False, encoding="utf-8-sig")
+    except (ValueError, UnicodeDecodeError) as exc:
+        fail(path, f"cannot be read as CSV ({exc})", "save it as comma-separated UTF-8 text with one header line")
+    raw.columns = [str(c).strip() for c in raw.columns]
+    levels = [c for c in LEVEL.values() if c in raw.columns]
+    if len(levels) != 1:
+        found = " and ".join(levels) or "neither"
+        fail(path, f"it needs exactly one of the columns level_g, level_lbf (found {found})",
+             "give level_g for base-driven or level_lbf for force-driven campaigns")
+    need = ["run_id", "assembly", "sequence", levels[0], "direction", *POSITIVE, "file"]
+    missing = [c for c in need if c not in raw.columns]
+    if missing:
+        fail(path, f"column(s) {', '.join(missing)} missing (found: {', '.join(raw.columns)})",
+             f"use the header {','.join(need)}")
+    if raw.empty:
+        fail(path, "it lists no runs", "add one row per run")
+    rows = [_manifest_row(rec, path, i + 2, levels[0]) for i, rec in enumerate(raw.to_dict("records"))]
+    df = pd.DataFrame(rows, columns=need + [c for c in raw.columns if c not in need])
+    for keys in (["run_id"], ["file"], ["assembly", "sequence"]):
+        dup = df.duplicated(keys, keep=False)
+        if dup.any():
+            first = df.loc[dup].iloc[0]
+            same = dup & (df[keys] == first[keys]).all(axis=1)
+            lines = ", ".join(str(i + 2) for i in np.flatnonzero(same))
+            what = " ".join(f"{k} {first[k]!r}" if k != "sequence" else f"sequence {first[k]} of"
+                            for k in reversed(keys))
+            fail(path, f"lines {lines} repeat {what}", f"make each {' within '.join(reversed(keys))} unique")
+    return df
+
+
+def _manifest_row(rec: dict[str, str], path: Path, line: int, level: str) -> dict[str, Any]:
+    where = f"{path}: line {line} (run_id {rec['run_id'].strip()!r})"
+    out: dict[str, Any] = {k: v.strip() for k, v in rec.items()}
+    for col in (*TEXT, "sequence", level, *POSITIVE):
+        if not out[col]:
+            fail(where, f"{col} is empty", f"fill in {col}")
+    try:
+        out["sequence"] = int(out["sequence"])
+    except ValueError:
+        out["sequence"] = 0
+    if out["sequence"] < 1:
+        fail(where, f"sequence {rec['sequence'].strip()!r} is not an integer >= 1",
+             "number the runs of each assembly 1, 2, 3, ... in test order")
+    for col in (level, *POSITIVE):
+        try:
+            out[col] = float(out[col])
+        except ValueError:
+            out[col] = float("nan")
+        if not (np.isfinite(out[col]) and out[col] > 0):
+            fail(where, f"{col} {rec[col].strip()!r} is not a positive number", f"write {col} as a number > 0")
+    out["direction"] = out["direction"].lower()
+    f0, f1, fs = out["f_start_hz"], out["f_stop_hz"], out["sample_rate_hz"]
+    if out["direction"] not in ("up", "down"):
+        fail(where, f"direction {rec['direction'].strip()!r} is not up or down", "write up or down")
+    if (out["direction"] == "up") != (f0 < f1) or f0 == f1:
+        sweep = "an up" if out["direction"] == "up" else "a down"
+        fail(where, f"{sweep} sweep cannot go from {f0:g} Hz to {f1:g} Hz",
+             "use f_start_hz < f_stop_hz for up and f_start_hz > f_stop_hz for down")
+    if max(f0, f1) >= fs / 2:
+        fail(where, f"the band reaches {max(f0, f1):g} Hz, above Nyquist ({fs / 2:g} Hz)",
+             "check the band and sample_rate_hz")
+    return out
+
+
+def read_run(path: str | os.PathLike[str]) -> pd.DataFrame:
+    """Read one run record (``.csv``, ``.csv.gz`` or MATLAB ``.mat``).
+
+    Parameters
+    ----------
+    path : path-like
+        CSV with the header ``time_s,base_accel_g,response_accel_g`` (force-driven:
+        ``time_s,force_lbf,response_accel_g``), gzip-compressed CSV, or a MATLAB v5/v7
+        file holding variables of those names as row or column vectors (other
+        variables are ignored).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``time_s`` (s), ``base_accel_g`` (g) or ``force_lbf`` (lbf),
+        ``response_accel_g`` (g), all float64, shape (n, 3). Empty cells become NaN.
+
+    Raises
+    ------
+    CampaignError
+        Unsupported suffix, unreadable file, wrong columns, non-numeric values or
+        vectors of different lengths.
+    """
+    path = Path(path)
+    name = path.name.lower()
+    if name.endswith(".mat"):
+        cols = _read_mat(path)
+    elif name.endswith((".csv", ".csv.gz")):
+        cols = _read_csv(path)
+    else:
+        fail(path, "unsupported file type", "store runs as .csv, .csv.gz or .mat")
+    return pd.DataFrame(cols)
+
+
+def _read_csv(path: Path) -> dict[str, NDArray[np.float64]]:
+    try:
+        df = pd.read_csv(path, skipinitialspace=True)
+    except (OSError, EOFError, ValueError, UnicodeDecodeError) as exc:
+        fail(path, f"cannot be read as CSV ({exc})", "re-export it as comma-separated text with one header line")
+    df.columns = [str(c).strip() for c in df.columns]
+    kind = excitation_of(list(df.columns), path)
+    out = {}
+    for col in (TIME, REFERENCE[kind], RESPONSE):
+        values = pd.to_numeric(df[col], errors="coerce")
+        bad = values.isna() & df[col].notna()
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            fail(path, f"column '{col}' has the non-numeric value {df[col].iloc[i]!r} on line {i + 2}",
+                 "export plain numbers")
+        out[col] = values.to_numpy(np.float64)
+    return out
+
+
+def _read_mat(path: Path) -> dict[str, NDArray[np.float64]]:
+    try:
+        mat = scipy.io.loadmat(path)
+    except NotImplementedError:
+        fail(path, "it is a MATLAB v7.3 (HDF5) file", "save it with save(..., '-v7')")
+    except (OSError, ValueError, TypeError) as exc:
+        fail(path, f"cannot be read as a MATLAB file ({exc})", "save it with MATLAB's save(..., '-v7')")
+    names = [k for k in mat if not k.startswith("__")]
+    kind = excitation_of([n for n in names if n in (TIME, RESPONSE, *REFERENCE.values())], path)
+    out = {}
+    for var in (TIME, REFERENCE[kind], RESPONSE):
+        a = np.asarray(mat[var])
+        if a.ndim > 2 or (a.ndim == 2 and min(a.shape) != 1) or not np.issubdtype(a.dtype, np.number):
+            fail(path, f"variable '{var}' is a {a.dtype} array of shape {a.shape}, not a numeric vector",
+                 "save each channel as a row or column vector")
+        out[var] = a.ravel().astype(np.float64)
+    lengths = {len(v) for v in out.values()}
+    if len(lengths) != 1:
+        fail(path, f"variables have different lengths {sorted(lengths)}", "save the three channels with one length")
+    return out
+
+
+def ingest_campaign(campaign_dir: str | os.PathLike[str], *,
+                    on_data_problem: OnDataProblem = "error") -> pd.DataFrame:
+    """Read and validate a whole campaign folder.
+
+    Parameters
+    ----------
+    campaign_dir : path-like
+        Folder holding ``manifest.csv`` and the run files it lists.
+    on_data_problem : {'error', 'flag'}, optional
+        Passed to `validate_run`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per run in manifest order: the manifest's columns, then the checks
+        of `validate_run`, with ``flags`` joined by ';' (empty string when clean).
+
+    Raises
+    ------
+    CampaignError
+        The first contract violation found, including a run file that is missing.
+    """
+    campaign_dir = Path(campaign_dir)
+    manifest = read_manifest(campaign_dir / "manifest.csv")
+    rows = []
+    for _, row in manifest.iterrows():
+        path = campaign_dir / row["file"]
+        if not path.is_file():
+            fail(path, f"the file of run {row['run_id']!r} listed in manifest.csv does not exist",
+                 "add the file or correct its name in the manifest's file column")
+        checks = validate_run(read_run(path), row, path, on_data_problem=on_data_problem)
+        checks["flags"] = ";".join(checks["flags"])
+        rows.append({**row.to_dict(), **checks})
+    return pd.DataFrame(rows)

@@ -1,0 +1,11 @@
+"""Joint and structure models: exact Iwan, QSMA, harmonic balance, swept-sine simulator."""
+from .amplitude import G, harmonic_balance, jenkins_inphase, qsma, resonance_amplitude
+from .iwan import IwanParams, backbone, backbone_stiffness, derived, dissipation, force_history
+from .simulate import SimResult, fractional_delay, simulate
+from .structure import Fixture, MinistackModel, state_space
+
+__all__ = [
+    "G", "IwanParams", "derived", "backbone", "backbone_stiffness", "dissipation", "force_history",
+    "qsma", "harmonic_balance", "jenkins_inphase", "resonance_amplitude",
+    "MinistackModel", "Fixture", "state_space", "simulate", "SimResult", "fractional_delay",
+]

@@ -1,0 +1,160 @@
+"""Swept-sine time integration of the base-excited Ministack model.
+
+`simulate` drives a `MinistackModel` with a base-acceleration history (measured or
+synthetic) and returns the response accelerometer's signal at the input samples.
+The joint force is the exact Iwan hysteresis (turning-point rules, no sliders); the
+linear structure is propagated exactly (zero natural-frequency error at any step);
+see `jointcal.models._integrator` for the scheme.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.linalg import expm
+
+from . import _integrator
+from .amplitude import G
+from ._masing import kernel_constants
+from .iwan import derived
+from .structure import MinistackModel, state_space
+
+__all__ = ["SimResult", "simulate", "hermite_propagator", "fractional_delay", "substeps"]
+
+
+@dataclass(frozen=True)
+class SimResult:
+    """response_g: response channel (g); z_in: joint relative displacement (in); n_sub: substeps per sample."""
+
+    response_g: NDArray[np.float64]
+    z_in: NDArray[np.float64]
+    n_sub: int
+
+
+def hermite_propagator(A: NDArray, b: NDArray, h: float):
+    """Exact one-step maps for x' = A x + b p(t), p a cubic Hermite over [0, h].
+
+    Returns Phi = expm(A h) and G (n, 4) such that
+    x(h) = Phi x(0) + G @ [p(0), h p'(0), p(h), h p'(h)].
+    Uses phi-functions from one augmented matrix exponential.
+    """
+    n = A.shape[0]
+    W = np.zeros((n + 4, n + 4))
+    W[:n, :n] = A * h
+    W[:n, n] = b * h
+    W[n:n + 3, n + 1:n + 4] = np.eye(3)
+    E = expm(W)
+    Phi = E[:n, :n]
+    phis = E[:n, n:n + 4]  # phi_1..phi_4 (A h) (b h)
+    g0, g1, g2, g3 = phis[:, 0], phis[:, 1], 2.0 * phis[:, 2], 6.0 * phis[:, 3]  # int e^{A(h-s)} b (s/h)^j ds
+    Gm = np.column_stack([g0 - 3 * g2 + 2 * g3, g1 - 2 * g2 + g3, 3 * g2 - 2 * g3, g3 - g2])
+    return Phi, Gm
+
+
+def substeps(model: MinistackModel, fs: float, omega_h: float = 0.65) -> int:
+    """Substeps per input sample so that omega_0 h <= omega_h at the stuck-joint frequency."""
+    return max(1, int(np.ceil(2 * np.pi * model.f0_hz / (omega_h * fs))))
+
+
+def _substep_maps(Gu: NDArray, n_sub: int):
+    """Input maps per substep of a parent sample interval (see `_integrator.run`).
+
+    Over the parent interval the input is the cubic Hermite through the samples; its
+    value and h-scaled rate at substep nodes tau_j = j/n_sub are linear in the parent
+    data [u_k, H u'_k, u_k+1, H u'_k+1], so each substep's input map is Gu @ W_j.
+    """
+    tau = np.arange(n_sub + 1) / n_sub
+    val = np.stack([1 - 3 * tau**2 + 2 * tau**3, tau - 2 * tau**2 + tau**3,
+                    3 * tau**2 - 2 * tau**3, tau**3 - tau**2], axis=1)
+    der = np.stack([-6 * tau + 6 * tau**2, 1 - 4 * tau + 3 * tau**2,
+                    6 * tau - 6 * tau**2, 3 * tau**2 - 2 * tau], axis=1) / n_sub
+    W = np.stack([val[:-1], der[:-1], val[1:], der[1:]], axis=1)  # (n_sub, 4, 4)
+    Gsub = np.ascontiguousarray(np.einsum("ic,jcd->jid", Gu, W))
+    return Gsub, np.ascontiguousarray(val[1:])
+
+
+def fractional_delay(x: ArrayLike, tau: float, fs: float) -> NDArray[np.float64]:
+    """Delay a sampled signal by tau seconds (any fraction of a sample), exactly in frequency.
+
+    The record is zero-padded before the FFT phase shift so nothing wraps around.
+    """
+    x = np.asarray(x, dtype=float)
+    if tau == 0.0:
+        return x.copy()
+    n = x.size
+    pad = int(np.ceil(abs(tau) * fs)) + 16
+    nfft = 1 << int(np.ceil(np.log2(n + 2 * pad)))
+    X = np.fft.rfft(x, nfft)
+    f = np.fft.rfftfreq(nfft, 1.0 / fs)
+    return np.fft.irfft(X * np.exp(-2j * np.pi * f * tau), nfft)[:n]
+
+
+def simulate(model: MinistackModel, base_accel_g: ArrayLike, fs: float, *,
+             n_sub: int | None = None, omega_h: float = 0.65,
+             sliders: tuple[NDArray, NDArray] | None = None) -> SimResult:
+    """Response of the model to a base-acceleration history.
+
+    Parameters
+    ----------
+    model : MinistackModel
+        Structure, joint and named effects.
+    base_accel_g : array_like, shape (N,)
+        Control-accelerometer signal, g, sampled at `fs`; the model starts at rest.
+    fs : float
+        Sample rate, Hz.
+    n_sub : int, optional
+        Integration substeps per sample; default from `substeps` with `omega_h`.
+    omega_h : float
+        Largest omega_0 * h allowed when choosing n_sub (rad). The linear part is exact
+        at any step; this bounds the error of the joint's nonlinear force. Measured on
+        the Table 3.2 joint at omega_0 h = 0.6: resonance frequency within 0.01% and
+        phase-resonance damping within 0.4% of the converged (n_sub = 8) result.
+    sliders : (k, phi), optional
+        Replace the exact Iwan joint by Jenkins sliders (stiffness lbf/in, slip in),
+        e.g. from `jointcal.models.sliders.slider_set`: a test reference only. The
+        stuck stiffness is then the sliders' total, not model.iwan.KT.
+
+    Returns
+    -------
+    SimResult
+        Response-channel acceleration (g, with sensor gain and delay applied) and the
+        joint displacement (in), both at the input samples.
+    """
+    u = np.ascontiguousarray(base_accel_g, dtype=float) * G
+    if u.ndim != 1 or u.size < 2:
+        raise ValueError("simulate: base_accel_g must be a 1-D record of at least 2 samples.")
+    if not np.all(np.isfinite(u)):
+        raise ValueError("simulate: base_accel_g holds NaN or inf; clean or trim the record first.")
+    if not fs > 0:
+        raise ValueError(f"simulate: sample rate must be positive, got {fs!r}.")
+    n_sub = substeps(model, fs, omega_h) if n_sub is None else int(n_sub)
+    ss = state_space(model)
+    H = 1.0 / fs
+    h = H / n_sub
+    Phi, Gu = hermite_propagator(ss.A, ss.bu, h)
+    _, Gf = hermite_propagator(ss.A, ss.bf, h)
+    Gsub, Wub = _substep_maps(Gu, n_sub)
+    az = ss.lv @ ss.A
+    bzu = float(ss.lv @ ss.bu)
+    bzf = float(ss.lv @ ss.bf)
+    sk = sphi = np.zeros(0)
+    if model.iwan is None:
+        joint, KT, R, chi, phimax, Fs = 0, 0.0, 0.0, 0.5, 1.0, 0.0
+    elif sliders is not None:
+        sk, sphi = (np.ascontiguousarray(a, dtype=float) for a in sliders)
+        joint, KT, R, chi, phimax, Fs = 2, float(sk.sum()), 0.0, 0.5, 1.0, 0.0
+    else:
+        p = model.iwan
+        phimax, R, _ = (float(a) for a in derived(p.Fs, p.KT, p.chi, p.beta))
+        R, chi = kernel_constants(R, p.chi)
+        joint, KT, Fs = 1, p.KT, p.Fs
+    y = np.empty_like(u)
+    z = np.empty_like(u)
+    _integrator.run(u, _integrator.rate(u, fs), H, Gsub, Wub, np.ascontiguousarray(Phi), np.ascontiguousarray(Gf), ss.lz, ss.lv, az, bzu, bzf,
+                    ss.cy, ss.dyu, ss.dyf, joint, KT, R, chi, phimax, Fs, sk, sphi,
+                    float(model.k3), float(model.c2), y, z)
+    if model.sensor_delay_s != 0.0:
+        y = fractional_delay(y, model.sensor_delay_s, fs)
+    y *= model.sensor_gain / G
+    return SimResult(response_g=y, z_in=z, n_sub=n_sub)

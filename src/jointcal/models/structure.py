@@ -1,0 +1,148 @@
+"""Linear structure of the base-excited Ministack model, and its named effects.
+
+The slug (mass m) sits on a linear spring k in parallel with the Iwan joint and a
+dashpot c = 2 zeta_v sqrt((k + KT) m) (zeta_v is the viscous ratio at the stuck-joint
+frequency). Coordinates are relative to the control accelerometer (the base):
+
+* no fixture:  q = [z],        z = x_slug - x_base;
+* fixture:     q = [w, z],     w = x_can - x_base, z = x_slug - x_can: the can (mass
+  m_can on a spring of own frequency f_can, ratio zeta_can) is an extra DOF between
+  the control accelerometer and the joint, loaded by the slug.
+
+M q'' + C q' + K q = -M_b a_base - e_z r_nl, where K holds the STUCK joint stiffness
+KT and r_nl is the nonlinear remainder of the joint restoring force,
+r_nl = F_iwan(z) - KT z + k3 z^3 + c2 z'|z'|. The response channel is the slug's
+absolute acceleration a_base + s.q''. Adding an effect means adding a field here and
+its terms to `state_space` (linear) or to r_nl (nonlinear); the integrator does not
+change. Sensor effects (gain, delay) act on the output channel after integration.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .iwan import IwanParams
+
+__all__ = ["Fixture", "MinistackModel", "StateSpace", "state_space"]
+
+
+@dataclass(frozen=True)
+class Fixture:
+    """Flexible can between the control accelerometer and the joint.
+
+    m_can : moving mass of the can, lbf s^2/in; f_can : its own frequency on its
+    spring with the slug removed, Hz; zeta_can : its viscous damping ratio.
+    """
+
+    m_can: float
+    f_can: float
+    zeta_can: float = 0.01
+
+
+@dataclass(frozen=True)
+class MinistackModel:
+    """Slug on a spring k in parallel with an Iwan joint, base excited.
+
+    Parameters
+    ----------
+    m : float
+        Slug mass, lbf s^2/in (weight / 386.089).
+    k : float
+        Linear spring in parallel with the joint, lbf/in.
+    zeta_v : float
+        Viscous damping ratio at the stuck-joint frequency sqrt((k + KT)/m).
+    iwan : IwanParams or None
+        The joint; None gives the linear model with stiffness k.
+    fixture : Fixture or None
+        Flexible can DOF (named effect ``fixture_flexibility``).
+    k3 : float
+        Cubic spring in parallel with the joint, lbf/in^3 (``cubic_stiffening``).
+    c2 : float
+        Quadratic damper c2 z'|z'|, lbf s^2/in^2 (``quadratic_damping``).
+    sensor_gain : float
+        Response-channel sensitivity error factor (``sensor_gain``).
+    sensor_delay_s : float
+        Response-channel delay, s (``channel_delay``).
+    """
+
+    m: float
+    k: float
+    zeta_v: float
+    iwan: IwanParams | None = None
+    fixture: Fixture | None = None
+    k3: float = 0.0
+    c2: float = 0.0
+    sensor_gain: float = 1.0
+    sensor_delay_s: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("m", "k"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise ValueError(f"MinistackModel.{name} must be positive and finite, got {v!r}.")
+        if not (0 <= self.zeta_v < 1):
+            raise ValueError(f"MinistackModel.zeta_v must lie in [0, 1), got {self.zeta_v!r}.")
+        if not (self.sensor_gain > 0):
+            raise ValueError(f"sensor_gain must be positive, got {self.sensor_gain!r}.")
+
+    @property
+    def KT(self) -> float:
+        """Stuck joint stiffness, lbf/in (0 without a joint)."""
+        return 0.0 if self.iwan is None else self.iwan.KT
+
+    @property
+    def f0_hz(self) -> float:
+        """Stuck-joint natural frequency of the slug on a rigid base, Hz."""
+        return float(np.sqrt((self.k + self.KT) / self.m) / (2 * np.pi))
+
+
+@dataclass(frozen=True)
+class StateSpace:
+    """x' = A x + bu u + bf r_nl; y = cy.x + dyu u + dyf r_nl; z = lz.x, z' = lv.x."""
+
+    A: np.ndarray
+    bu: np.ndarray
+    bf: np.ndarray
+    cy: np.ndarray
+    dyu: float
+    dyf: float
+    lz: np.ndarray
+    lv: np.ndarray
+    extra: dict = field(default_factory=dict)
+
+
+def state_space(model: MinistackModel) -> StateSpace:
+    """Assemble the first-order linear system with the joint stuck (stiffness k + KT)."""
+    m, ks = model.m, model.k + model.KT
+    c = 2.0 * model.zeta_v * np.sqrt(ks * m)
+    if model.fixture is None:
+        M = np.array([[m]])
+        K = np.array([[ks]])
+        C = np.array([[c]])
+        Mb = np.array([m])
+        ez = np.array([1.0])
+    else:
+        fx = model.fixture
+        k_can = fx.m_can * (2 * np.pi * fx.f_can) ** 2
+        c_can = 2.0 * fx.zeta_can * np.sqrt(k_can * fx.m_can)
+        M = np.array([[fx.m_can + m, m], [m, m]])
+        K = np.diag([k_can, ks])
+        C = np.diag([c_can, c])
+        Mb = np.array([fx.m_can + m, m])
+        ez = np.array([0.0, 1.0])
+    n = M.shape[0]
+    Minv = np.linalg.inv(M)
+    A = np.zeros((2 * n, 2 * n))
+    A[:n, n:] = np.eye(n)
+    A[n:, :n] = -Minv @ K
+    A[n:, n:] = -Minv @ C
+    bu = np.concatenate([np.zeros(n), -Minv @ Mb])
+    bf = np.concatenate([np.zeros(n), -Minv @ ez])
+    s = np.ones(n)  # slug absolute acceleration = a_base + sum of relative accelerations
+    cy = s @ A[n:]
+    dyu = 1.0 + s @ bu[n:]
+    dyf = s @ bf[n:]
+    lz = np.concatenate([ez, np.zeros(n)])
+    lv = np.concatenate([np.zeros(n), ez])
+    return StateSpace(A, bu, bf, cy, float(dyu), float(dyf), lz, lv)

@@ -1,0 +1,70 @@
+"""Run the Snakemake workflow on the small campaign from a copy of the repository's workflow."""
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+from _campaign import REPO, edit_run
+
+pytestmark = pytest.mark.slow
+
+
+@pytest.fixture
+def workdir(tmp_path: Path) -> Path:
+    """A copy of Snakefile, workflow/ and profiles/ (the working directory of each run)."""
+    work = tmp_path / "wf"
+    work.mkdir()
+    shutil.copy(REPO / "Snakefile", work)
+    for folder in ("workflow", "profiles"):
+        shutil.copytree(REPO / folder, work / folder, ignore=shutil.ignore_patterns("__pycache__"))
+    return work
+
+
+def _snakemake(work: Path, *args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "snakemake", *args], cwd=work, capture_output=True, text=True,
+                          timeout=300)
+
+
+def test_ingest_rule_tabulates_every_run(workdir, tmp_path, small_campaign):
+    out = tmp_path / "results"
+    res = _snakemake(workdir, "--cores", "2", "ingest", "--config", f"raw_data={small_campaign}", f"results={out}")
+    assert res.returncode == 0, res.stderr
+    runs = pd.read_csv(out / "ingest" / "runs.csv")
+    manifest = pd.read_csv(small_campaign / "manifest.csv")
+    assert list(runs["run_id"]) == list(manifest["run_id"])
+    assert "ingested 5 runs" in (out / "logs" / "ingest.log").read_text()
+
+
+def test_bare_run_uses_default_profile(workdir, tmp_path, small_campaign):
+    out = tmp_path / "results"
+    res = _snakemake(workdir, "--config", f"raw_data={small_campaign}", f"results={out}")  # no --cores
+    assert res.returncode == 0, res.stderr
+    assert "profiles/default" in res.stderr + res.stdout
+    assert (out / "ingest" / "runs.csv").is_file()
+
+
+def test_malformed_campaign_fails_naming_the_file(workdir, tmp_path, campaign):
+    edit_run(campaign, "run03.csv.gz", lambda d: d.rename(columns={"response_accel_g": "resp_g"}))
+    out = tmp_path / "results"
+    res = _snakemake(workdir, "--cores", "2", "ingest", "--config", f"raw_data={campaign}", f"results={out}")
+    assert res.returncode != 0
+    assert "run03.csv.gz: column 'response_accel_g' is missing" in res.stderr
+    assert "run03.csv.gz" in (out / "logs" / "ingest.log").read_text()
+    assert not (out / "ingest" / "runs.csv").exists()
+
+
+def test_missing_manifest_is_one_clear_line(workdir, tmp_path):
+    res = _snakemake(workdir, "-n", "--cores", "2", "--config", f"raw_data={tmp_path / 'nowhere'}")
+    assert res.returncode != 0
+    assert "nowhere/manifest.csv: the campaign manifest does not exist" in res.stderr
+    assert "Traceback" not in res.stderr and "File " not in res.stderr
+
+
+def test_lint_reports_only_the_expected_conda_advice(workdir, small_campaign, tmp_path):
+    res = _snakemake(workdir, "--lint", "--config", f"raw_data={small_campaign}", f"results={tmp_path / 'r'}")
+    items = [line.strip() for line in (res.stdout + res.stderr).splitlines() if line.strip().startswith("* ")]
+    assert items == ["* Specify a conda environment or container for each rule.:"], res.stdout + res.stderr
