@@ -68,3 +68,14 @@ def test_lint_reports_only_the_expected_conda_advice(workdir, small_campaign, tm
     res = _snakemake(workdir, "--lint", "--config", f"raw_data={small_campaign}", f"results={tmp_path / 'r'}")
     items = [line.strip() for line in (res.stdout + res.stderr).splitlines() if line.strip().startswith("* ")]
     assert items == ["* Specify a conda environment or container for each rule.:"], res.stdout + res.stderr
+
+
+def test_default_config_runs_on_the_example_campaign(workdir, tmp_path):
+    """`snakemake --cores 2` with the default raw_data/ (linked into the copy) runs every stage."""
+    (workdir / "raw_data").symlink_to(REPO / "raw_data")
+    out = tmp_path / "results"
+    res = _snakemake(workdir, "--cores", "2", "--config", f"results={out}")
+    assert res.returncode == 0, res.stderr
+    runs = pd.read_csv(out / "ingest" / "runs.csv")
+    assert len(runs) == 24 and runs["flags"].isna().all()
+    assert set(runs["assembly"]) == {"first", "reassembly"}

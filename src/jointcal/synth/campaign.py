@@ -1,0 +1,115 @@
+"""A virtual shaker lab: campaigns in the raw-data contract from a known truth.
+
+`generate(spec, out_dir, truth_path)` simulates every run of the spec's test series
+with the exact-Iwan swept-sine simulator (plus the hidden effect, if any), passes both
+channels through the measurement chain (`jointcal.synth.daq`), and writes the
+campaign (manifest + one file per run) and, separately, the truth: parameters, effect
+and per run the harmonic-balance steady-state resonance at that level.
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from ..io import write_csv_atomic, write_json_atomic, write_run
+from ..models import G, resonance_amplitude, simulate
+from . import daq
+from .effects import effect_defaults, run_model
+from .spec import load_spec
+
+__all__ = ["generate", "plan_runs"]
+
+_RANGES_G = (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000)
+
+
+def plan_runs(spec: dict) -> pd.DataFrame:
+    """The manifest rows of a spec's test series, before any simulation."""
+    rows = []
+    sw = spec["sweep"]
+    lo, hi = sorted((sw["f_start_hz"], sw["f_stop_hz"]))
+    for assembly in spec["assemblies"]:
+        seq = 0
+        for item in spec["series"]:
+            for _ in range(item.get("repeats", 1)):
+                for direction in item.get("directions", ["up", "down"]):
+                    seq += 1
+                    f0, f1 = (lo, hi) if direction == "up" else (hi, lo)
+                    run_id = f"{assembly}_{seq:02d}_{item['level_g']:g}g_{direction}"
+                    rows.append(dict(run_id=run_id, assembly=assembly, sequence=seq, level_g=float(item["level_g"]),
+                                     direction=direction, f_start_hz=f0, f_stop_hz=f1,
+                                     sweep_rate_hz_per_s=float(sw["rate_hz_per_s"]),
+                                     sample_rate_hz=float(spec["sample_rate_hz"]),
+                                     file=f"runs/{run_id}.{spec['file_format']}"))
+    return pd.DataFrame(rows)
+
+
+def _full_scale(setting: Any, peak: float) -> float:
+    """A channel's ADC range: a number (g), or 'auto' = smallest standard range >= 2x the peak."""
+    if setting == "auto":
+        return float(next((r for r in _RANGES_G if r >= 2.0 * peak), _RANGES_G[-1]))
+    return float(setting)
+
+
+def _truth_row(truth: dict, model, level: float) -> dict:
+    iw = model.iwan
+    q, f, z = resonance_amplitude(level, iw.Fs, iw.KT, iw.chi, iw.beta, model.k, model.m, model.zeta_v)
+    return dict(Fs=iw.Fs, KT=iw.KT, q_hb_in=float(q), f_hb_hz=float(f), zeta_hb=float(z))
+
+
+def generate(spec: dict | str | os.PathLike, out_dir: str | os.PathLike, truth_path: str | os.PathLike) -> pd.DataFrame:
+    """Write a campaign and its truth; return the truth table (one row per run).
+
+    Parameters
+    ----------
+    spec : dict or path
+        Truth spec (YAML/JSON); see `jointcal.synth.spec` for the keys.
+    out_dir : path
+        Campaign folder to create (manifest.csv and runs/).
+    truth_path : path
+        Where to write the truth JSON; must lie outside `out_dir`.
+    """
+    spec = load_spec(spec)
+    out_dir = Path(out_dir).resolve()
+    truth_path = Path(truth_path).resolve()
+    if out_dir == truth_path.parent or out_dir in truth_path.parents:
+        raise ValueError(f"{truth_path}: the truth file must not live inside the campaign folder {out_dir}; "
+                         "write it elsewhere (e.g. under tests/).")
+    rng = np.random.default_rng(spec["seed"])
+    meas = spec["measurement"]
+    fs_out = float(spec["sample_rate_hz"])
+    fs_sim = fs_out * int(meas["oversample"])
+    sos = daq.antialias(fs_sim, fs_out, meas["antialias_order"], meas["antialias_cutoff"])
+    effect = spec["effect"]["name"]
+    eparams = effect_defaults(effect, spec["effect"].get("params"))
+    m = spec["slug_weight_lbf"] / G
+    sw = spec["sweep"]
+    plan = plan_runs(spec)
+    truth_rows = []
+    for row in plan.itertuples(index=False):
+        run_rng = np.random.default_rng([spec["seed"], int(rng.integers(2**31))])
+        truth = dict(spec["assemblies"][row.assembly], m=m)
+        model = run_model(truth, row.sequence, effect, eparams)
+        t, f_inst, base = daq.controlled_sweep(fs_sim, row.f_start_hz, row.f_stop_hz, row.sweep_rate_hz_per_s,
+                                               row.level_g, rng=run_rng, ramp_s=sw["ramp_s"], tail_s=sw["tail_s"],
+                                               ripple=meas["ripple"], distortion=tuple(meas["distortion"]))
+        resp = simulate(model, base, fs_sim).response_g
+        chans, ranges = [], {}
+        for name, x in (("base", base), ("response", resp)):
+            fsg = ranges[f"full_scale_{name}_g"] = _full_scale(meas["full_scale_g"][name], float(np.max(np.abs(x))))
+            off = ranges[f"dc_offset_{name}_g"] = float(meas["dc_offset_g"] * run_rng.standard_normal())
+            chans.append(daq.measure(x, fs_sim, fs_out, rng=run_rng, noise_fraction=meas["noise_fraction"],
+                                     dc_offset=off, full_scale_g=fsg, bits=meas["bits"], sos=sos))
+        write_run(out_dir / row.file, t[:: int(meas["oversample"])], chans[0], chans[1], kind="base")
+        truth_rows.append(dict(run_id=row.run_id, assembly=row.assembly, sequence=row.sequence,
+                               level_g=row.level_g, direction=row.direction, **ranges,
+                               **_truth_row(truth, model, row.level_g)))
+    write_csv_atomic(plan, out_dir / "manifest.csv")
+    table = pd.DataFrame(truth_rows)
+    write_json_atomic(dict(spec=spec, effect=dict(name=effect, params=eparams),
+                           assemblies={a: dict(v, m=m) for a, v in spec["assemblies"].items()},
+                           runs=table.to_dict(orient="records")), truth_path)
+    return table

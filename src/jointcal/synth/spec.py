@@ -1,0 +1,145 @@
+"""Truth specs for synthetic campaigns: defaults, loading (YAML or JSON), validation.
+
+Keys (units lbf, in, s, g):
+
+seed                 int, required: every random draw follows from it.
+sample_rate_hz       output sample rate of the files.
+file_format          csv | csv.gz | mat.
+slug_weight_lbf      slug weight (mass = weight / 386.089).
+sweep                f_start_hz, f_stop_hz (the band, low or high first), rate_hz_per_s,
+                     ramp_s (cosine ramps), tail_s (free decay recorded after the sweep).
+series               list of {level_g, directions: [up, down], repeats}: the test order
+                     of each assembly (the paper's Table 3.1 by default).
+assemblies           {name: {Fs, KT, chi, beta, k, zeta_v}} (Table 3.2 by default).
+measurement          noise_fraction (of each channel's RMS), dc_offset_g (std), bits,
+                     full_scale_g {base, response} ('auto' or g), oversample (simulation
+                     rate / output rate), antialias_order, antialias_cutoff (x output
+                     rate), ripple (controller amplitude ripple), distortion [2nd, 3rd].
+effect               {name, params} or effect_file (YAML/JSON holding {name, params},
+                     relative to the spec): the hidden effect, 'none' by default.
+"""
+from __future__ import annotations
+
+import copy
+import json
+import os
+from pathlib import Path
+
+import yaml
+
+from .effects import effect_defaults
+
+__all__ = ["DEFAULT_SPEC", "load_spec"]
+
+DEFAULT_SPEC: dict = {
+    "sample_rate_hz": 12800.0,
+    "file_format": "csv.gz",
+    "slug_weight_lbf": 2.65,
+    "sweep": {"f_start_hz": 700.0, "f_stop_hz": 2500.0, "rate_hz_per_s": 300.0, "ramp_s": 0.05, "tail_s": 0.1},
+    "series": [
+        {"level_g": 1.0, "directions": ["up", "down"], "repeats": 3},
+        {"level_g": 2.0, "directions": ["up", "down"], "repeats": 1},
+        {"level_g": 5.0, "directions": ["up", "down"], "repeats": 1},
+        {"level_g": 10.0, "directions": ["up", "down"], "repeats": 1},
+    ],
+    "assemblies": {
+        "first": {"Fs": 313.0, "KT": 1.02e6, "chi": -0.65, "beta": 0.004, "k": 6.12e5, "zeta_v": 0.0015},
+        "reassembly": {"Fs": 274.0, "KT": 0.90e6, "chi": -0.61, "beta": 0.025, "k": 8.56e5, "zeta_v": 0.0017},
+    },
+    "measurement": {"noise_fraction": 0.003, "dc_offset_g": 0.005, "bits": 24,
+                    "full_scale_g": {"base": "auto", "response": "auto"}, "oversample": 2,
+                    "antialias_order": 8, "antialias_cutoff": 0.42, "ripple": 0.01, "distortion": [0.003, 0.002]},
+    "effect": {"name": "none", "params": {}},
+}
+
+
+def _merge(base: dict, over: dict) -> dict:
+    out = copy.deepcopy(base)
+    for k, v in over.items():
+        if k in out and isinstance(out[k], dict) and isinstance(v, dict) and k != "assemblies":
+            out[k] = _merge(out[k], v)
+        else:
+            out[k] = copy.deepcopy(v)
+    return out
+
+
+def _number(value, where: str, what: str) -> float:
+    """A float from a spec value; YAML 1.1 reads '1.02e6' as text, which is fine here."""
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{where}: {what} must be a number, got {value!r}.") from None
+    if not (out == out and abs(out) != float("inf")):
+        raise ValueError(f"{where}: {what} must be finite, got {value!r}.")
+    return out
+
+
+def _coerce(s: dict, where: str) -> None:
+    for key in ("sample_rate_hz", "slug_weight_lbf"):
+        s[key] = _number(s[key], where, key)
+    for key in ("f_start_hz", "f_stop_hz", "rate_hz_per_s", "ramp_s", "tail_s"):
+        s["sweep"][key] = _number(s["sweep"][key], where, f"sweep.{key}")
+    for name, a in s["assemblies"].items():
+        if not isinstance(a, dict):
+            raise ValueError(f"{where}: assembly {name!r} must map Fs, KT, chi, beta, k, zeta_v to numbers.")
+        for key in a:
+            a[key] = _number(a[key], where, f"assemblies.{name}.{key}")
+    for item in s["series"]:
+        item["level_g"] = _number(item.get("level_g"), where, "series level_g")
+        item["repeats"] = int(_number(item.get("repeats", 1), where, "series repeats"))
+    m = s["measurement"]
+    for key in ("noise_fraction", "dc_offset_g", "antialias_cutoff", "ripple"):
+        m[key] = _number(m[key], where, f"measurement.{key}")
+    for key in ("bits", "oversample", "antialias_order"):
+        m[key] = int(_number(m[key], where, f"measurement.{key}"))
+    m["distortion"] = [_number(v, where, "measurement.distortion") for v in m["distortion"]]
+    for ch, v in m["full_scale_g"].items():
+        m["full_scale_g"][ch] = v if v == "auto" else _number(v, where, f"measurement.full_scale_g.{ch}")
+
+
+def load_spec(spec: dict | str | os.PathLike) -> dict:
+    """Complete a spec with the defaults and validate it (one clear error per problem)."""
+    where = "spec"
+    root = Path.cwd()
+    if not isinstance(spec, dict):
+        path = Path(spec)
+        where, root = str(path), path.parent
+        if not path.is_file():
+            raise ValueError(f"{path}: spec file not found; give the path of a YAML or JSON truth spec.")
+        text = path.read_text()
+        spec = json.loads(text) if path.suffix == ".json" else yaml.safe_load(text)
+        if not isinstance(spec, dict):
+            raise ValueError(f"{path}: a spec must be a mapping of keys (seed, assemblies, ...).")
+    unknown = set(spec) - set(DEFAULT_SPEC) - {"seed", "effect_file"}
+    if unknown:
+        raise ValueError(f"{where}: unknown key(s) {sorted(unknown)}; valid keys are {sorted(DEFAULT_SPEC)} + seed.")
+    if "seed" not in spec or not isinstance(spec["seed"], int):
+        raise ValueError(f"{where}: 'seed' must be given as an integer so the campaign is reproducible.")
+    s = _merge(DEFAULT_SPEC, spec)
+    if "effect_file" in s:
+        ef = root / s.pop("effect_file")
+        if not ef.is_file():
+            raise ValueError(f"{where}: effect_file {ef} not found; fix the path (relative to the spec).")
+        s["effect"] = (json.loads if ef.suffix == ".json" else yaml.safe_load)(ef.read_text())
+    s["effect"] = {"name": s["effect"].get("name", "none"), "params": s["effect"].get("params") or {}}
+    _coerce(s, where)
+    effect_defaults(s["effect"]["name"], s["effect"]["params"])
+    if s["file_format"] not in ("csv", "csv.gz", "mat"):
+        raise ValueError(f"{where}: file_format must be csv, csv.gz or mat, got {s['file_format']!r}.")
+    sw = s["sweep"]
+    if not (sw["rate_hz_per_s"] > 0 and sw["f_start_hz"] > 0 and sw["f_stop_hz"] > 0 and sw["f_start_hz"] != sw["f_stop_hz"]):
+        raise ValueError(f"{where}: sweep needs positive f_start_hz != f_stop_hz and rate_hz_per_s > 0, got {sw}.")
+    if max(sw["f_start_hz"], sw["f_stop_hz"]) >= 0.45 * s["sample_rate_hz"]:
+        raise ValueError(f"{where}: sample_rate_hz {s['sample_rate_hz']} is too low for a band up to "
+                         f"{max(sw['f_start_hz'], sw['f_stop_hz'])} Hz; use at least 2.3x the top frequency.")
+    for name, a in s["assemblies"].items():
+        missing = {"Fs", "KT", "chi", "beta", "k", "zeta_v"} - set(a)
+        if missing:
+            raise ValueError(f"{where}: assembly {name!r} lacks {sorted(missing)}.")
+    for item in s["series"]:
+        if not (item.get("level_g", 0) > 0) or any(d not in ("up", "down") for d in item.get("directions", ["up"])):
+            raise ValueError(f"{where}: series item {item} needs level_g > 0 and directions among up/down.")
+    m = s["measurement"]
+    if not (0 <= m["noise_fraction"] < 1 and m["bits"] >= 8 and int(m["oversample"]) >= 1):
+        raise ValueError(f"{where}: measurement needs 0 <= noise_fraction < 1, bits >= 8, oversample >= 1; got {m}.")
+    return s
