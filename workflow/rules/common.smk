@@ -19,3 +19,18 @@ def campaign_files(wildcards):
     with open(MANIFEST, newline="", encoding="utf-8-sig") as fh:
         listed = [(r.get("file") or "").strip() for r in csv.DictReader(fh)]
     return {"manifest": str(MANIFEST), "runs": [str(RAW_DATA / f) for f in listed if f]}
+
+
+def _manifest_rows():
+    with open(MANIFEST, newline="", encoding="utf-8-sig") as fh:
+        return [{k.strip(): (v or "").strip() for k, v in r.items()} for r in csv.DictReader(fh)]
+
+
+RUN_FILES = {r["run_id"]: str(RAW_DATA / r["file"]) for r in _manifest_rows() if r.get("run_id")}
+RUN_IDS = list(RUN_FILES)
+ASSEMBLIES = list(dict.fromkeys(r["assembly"] for r in _manifest_rows() if r.get("assembly")))
+
+
+def run_record(wildcards):
+    """The raw record of one run."""
+    return RUN_FILES[wildcards.run_id]

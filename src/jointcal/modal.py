@@ -1,0 +1,229 @@
+"""Measured modal properties of each run, and their scatter across repeats.
+
+From a run's envelopes (`jointcal.signal.envelopes`):
+
+* resonance where the relative displacement z is in quadrature with the base
+  acceleration (z leads a_base by 90 deg, i.e. lags the effective force -m a_base by
+  90 deg; interpolated crossing), corrected for the sweep's lag: a sweep at rate r
+  shows the steady-state phase delayed by the group delay tau_g = |d phi / d omega|,
+  so f_res = f_crossing - sgn(r) r tau_g, tau_g measured from the phase slope at the
+  crossing (first order in eta; method 'quadrature'). Beyond eta_frf the envelopes are
+  not quasi-steady and the whole-record FRF's quadrature is used (method 'frf').
+* the peak of the response envelope (the paper's resonance read-out);
+* damping by half-power bandwidth of the response envelope (the paper's estimate),
+  and by phase-resonance energy balance at quadrature, zeta = |a_base| / (2 omega^2 q)
+  (one amplitude, no bandwidth); force-driven: zeta = |F| / (2 m |a|).
+* group_delay_s: |d phi/d omega| of the quadrature phase at the crossing (s), the
+  slope used for the sweep-lag correction;
+* quality flags; a flagged value is kept and marked, never dropped. 'unusable' marks a
+  row the calibration must not use.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from .models import G
+
+__all__ = ["modal_properties", "scatter", "FLAG_WORDS"]
+
+FLAG_WORDS = {
+    "eta_high": "sweep too fast for quasi-steady envelopes (eta > eta_max)",
+    "no_quadrature": "the phase never reaches quadrature; f_res is the envelope peak",
+    "resonance_outside_band": "the response peak sits at the edge of the driven band",
+    "low_snr": "response at resonance less than snr_min above the noise floor",
+    "bad_samples": "NaN/inf or clipped samples; frames touching them were left out",
+    "no_half_power": "a half-power point lies outside the record",
+    "unusable": "no resonance could be estimated from this run",
+}
+
+
+def _crossing(x: np.ndarray, target: float) -> np.ndarray:
+    """Indices i where x crosses target between i and i+1."""
+    d = x - target
+    return np.flatnonzero((d[:-1] == 0) | (d[:-1] * d[1:] < 0))
+
+
+def _interp(i: int, w: float, *arrays):
+    return [a[i] + w * (a[i + 1] - a[i]) for a in arrays]
+
+
+def _half_power(f: np.ndarray, a: np.ndarray, ip: int):
+    """Half-power frequencies around the peak index ip of envelope a(f); NaN if not found."""
+    level = a[ip] / np.sqrt(2.0)
+    lo = hi = np.nan
+    left = np.flatnonzero(a[:ip] < level)
+    if left.size:
+        i = left[-1]
+        lo = f[i] + (level - a[i]) * (f[i + 1] - f[i]) / (a[i + 1] - a[i])
+    right = np.flatnonzero(a[ip:] < level)
+    if right.size:
+        i = ip + right[0]
+        hi = f[i - 1] + (level - a[i - 1]) * (f[i] - f[i - 1]) / (a[i] - a[i - 1])
+    return min(lo, hi), max(lo, hi)
+
+
+def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass_lbf: float = 2.65,
+                     eta_max: float = 0.5, eta_frf: float = 4.0, snr_min_db: float = 20.0,
+                     record: pd.DataFrame | None = None) -> dict:
+    """Resonance, damping, amplitudes and flags of one run (one row of modal_properties.csv).
+
+    Parameters
+    ----------
+    env : DataFrame
+        The run's envelopes.
+    row : mapping
+        Its manifest row.
+    rate_hz_per_s : float
+        Measured sweep rate (Hz/s), from the envelopes' ridge.
+    mass_lbf : float
+        Weight of the moving mass (lbf), used only for force-driven damping.
+    record : DataFrame, optional
+        The raw record, for the whole-record FRF when the sweep is too fast.
+    """
+    force = "force_lbf" in (record.columns if record is not None else []) or "level_lbf" in row
+    flags: list[str] = []
+    use = env["drive_on"].to_numpy() & ~env["bad"].to_numpy()
+    if env["bad"].any():
+        flags.append("bad_samples")
+    e = env[use]
+    out = {k: row[k] for k in ("run_id", "assembly", "sequence", "direction") if k in row}
+    out["level_lbf" if force else "level_g"] = row.get("level_lbf" if force else "level_g", np.nan)
+    nan = dict(f_res_hz=np.nan, f_crossing_hz=np.nan, f_peak_hz=np.nan, zeta_half_power=np.nan,
+               zeta_phase_resonance=np.nan, q_in=np.nan, response_g=np.nan, base_g=np.nan, eta=np.nan,
+               group_delay_s=np.nan, snr_db=np.nan, h2_ratio=np.nan, h3_ratio=np.nan, f_res_method="none")
+    if len(e) < 8:
+        return {**out, **nan, "flags": ";".join(flags + ["unusable"])}
+    f = e["f_drive_hz"].to_numpy()
+    Rf = (e["ref_re"] + 1j * e["ref_im"]).to_numpy()
+    R = (e["resp_re"] + 1j * e["resp_im"]).to_numpy()
+    Z = (e["z_re"] + 1j * e["z_im"]).to_numpy()
+    sgn = 1.0 if row["f_stop_hz"] > row["f_start_hz"] else -1.0
+    # quadrature: z leads the base acceleration (or a_resp leads the force) by +90 deg
+    ratio = Z / Rf if not force else R / Rf
+    ph = np.unwrap(np.angle(ratio))
+    ph += 2 * np.pi * np.round((np.pi / 2 - np.median(ph)) / (2 * np.pi))
+    ip = int(np.argmax(np.abs(R)))
+    if 0 < ip < len(f) - 1:  # quadratic refinement of the envelope peak
+        y0, y1, y2 = np.abs(R[ip - 1:ip + 2])
+        den = y0 - 2 * y1 + y2
+        d = 0.5 * (y0 - y2) / den if den < 0 else 0.0
+        f_peak = f[ip] + d * (f[ip + 1] - f[ip - 1]) / 2
+    else:
+        f_peak = f[ip]
+    # a resonance outside the band shows as a transmissibility peak at the driven span's edge
+    # (frames at full drive only: ramps divide a ringing response by a vanishing base)
+    full = np.abs(Rf) >= 0.8 * np.median(np.abs(Rf))
+    ff = f[full]
+    f_T = ff[int(np.argmax(np.abs(R / Rf)[full]))]
+    edge = min(f_T - ff.min(), ff.max() - f_T) < 0.02 * (ff.max() - ff.min())
+    lo, hi = _half_power(f, np.abs(R), ip)
+    zeta_hp = (hi - lo) / (2 * f_peak) if np.isfinite(lo + hi) else np.nan
+    if not np.isfinite(zeta_hp):
+        flags.append("no_half_power")
+    cands = _crossing(ph, np.pi / 2)
+    if cands.size:
+        i = cands[np.argmin(np.abs(f[cands] - f_peak))]
+        w = (np.pi / 2 - ph[i]) / (ph[i + 1] - ph[i]) if ph[i + 1] != ph[i] else 0.0
+        f_x, t_x = _interp(i, w, f, e["time_s"].to_numpy())
+        q, a_resp, a_ref = (float(v) for v in _interp(i, w, np.abs(Z), np.abs(R), np.abs(Rf)))
+        # group delay from the phase slope over frames within +-zeta f/2 of the crossing
+        z_guess = a_ref * G / (2 * (2 * np.pi * f_x) ** 2 * q) if not force else 0.02
+        near = np.abs(f - f_x) <= max(0.5 * z_guess * f_x, 2.5 * np.median(np.abs(np.diff(f))))
+        slope = np.polyfit(f[near], ph[near], 1)[0] if near.sum() >= 3 else (ph[i + 1] - ph[i]) / (f[i + 1] - f[i])
+        tau_g = abs(slope) / (2 * np.pi)
+        f_res = f_x - sgn * rate_hz_per_s * tau_g
+        method = "quadrature"
+    else:
+        flags.append("no_quadrature")
+        f_x, t_x = f_peak, np.nan
+        q, a_resp, a_ref = float(np.abs(Z[ip])), float(np.abs(R[ip])), float(np.abs(Rf[ip]))
+        f_res, method = f_peak, "peak"
+        tau_g = np.nan
+    omega = 2 * np.pi * f_res
+    if force:
+        zeta_pr = a_ref / (2 * (mass_lbf / G) * a_resp * G) if method == "quadrature" else np.nan
+    else:
+        zeta_pr = a_ref * G / (2 * omega**2 * q) if method == "quadrature" else np.nan
+    zeta_eta = zeta_pr if np.isfinite(zeta_pr) else zeta_hp
+    eta = rate_hz_per_s / (f_res * zeta_eta) ** 2 if np.isfinite(zeta_eta) else np.nan
+    if np.isfinite(eta) and eta > eta_frf and record is not None and method == "quadrature" and not force:
+        f_frf = _frf_quadrature(record, row, f_x)
+        if np.isfinite(f_frf):
+            f_res, method = f_frf, "frf"
+    if np.isfinite(eta) and eta > eta_max:
+        flags.append("eta_high")
+    if edge:
+        flags.append("resonance_outside_band")
+    noise = float(np.median(e["noise_g"]))
+    snr = 20 * np.log10(a_resp / noise) if noise > 0 else np.inf
+    if snr < snr_min_db:
+        flags.append("low_snr")
+    if method == "peak" and edge:
+        flags.append("unusable")
+    out.update(f_res_hz=float(f_res), f_crossing_hz=float(f_x), f_peak_hz=float(f_peak),
+               zeta_half_power=float(zeta_hp), zeta_phase_resonance=float(zeta_pr), q_in=float(q),
+               response_g=float(a_resp), base_g=float(a_ref) if not force else np.nan, eta=float(eta),
+               group_delay_s=float(tau_g), snr_db=float(snr), h2_ratio=float(e["h2_amp_g"].iloc[ip] / abs(R[ip])),
+               h3_ratio=float(e["h3_amp_g"].iloc[ip] / abs(R[ip])), f_res_method=method,
+               flags=";".join(dict.fromkeys(flags)))
+    if force:
+        out["force_lbf"] = float(a_ref)
+    return out
+
+
+def _frf_quadrature(record: pd.DataFrame, row: dict, f_guess: float) -> float:
+    """Quadrature frequency of the whole-record FRF of z over a_base (Hz), near f_guess.
+
+    The ratio of the Fourier transforms over the full sweep is free of the sweep-rate
+    bias of time-local envelopes for a linear system; for a nonlinear one it is the
+    equivalent FRF at that drive level.
+    """
+    base = np.nan_to_num(record["base_accel_g"].to_numpy(float))
+    resp = np.nan_to_num(record["response_accel_g"].to_numpy(float))
+    fs = float(row["sample_rate_hz"])
+    B = np.fft.rfft(base - base.mean())
+    Rr = np.fft.rfft(resp - resp.mean())
+    fr = np.fft.rfftfreq(base.size, 1 / fs)
+    band = (fr > 0.8 * f_guess) & (fr < 1.2 * f_guess)
+    k = max(1, int(round(2.0 / (fr[1] - fr[0]))))  # ~2 Hz smoothing of cross and auto spectra
+    ker = np.ones(k) / k
+    cross = np.convolve((Rr - B) * np.conj(B), ker, "same")[band]
+    ph = np.unwrap(np.angle(-cross))  # z = -(a_resp - a_base)/omega^2
+    ph += 2 * np.pi * np.round((np.pi / 2 - np.median(ph)) / (2 * np.pi))
+    c = _crossing(ph, np.pi / 2)
+    if not c.size:
+        return np.nan
+    i = c[np.argmin(np.abs(fr[band][c] - f_guess))]
+    w = (np.pi / 2 - ph[i]) / (ph[i + 1] - ph[i])
+    return float(fr[band][i] + w * (fr[band][i + 1] - fr[band][i]))
+
+
+def scatter(table: pd.DataFrame) -> pd.DataFrame:
+    """Scatter of f_res and damping across repeats and up/down pairs, per assembly.
+
+    Rows (assembly, quantity, level, source): 'repeats' for a level run more than twice,
+    'up_down' for a level with one up/down pair, and one 'pooled' row per (assembly,
+    quantity) with the dof-weighted pooled relative standard deviation (level NaN).
+    Rows flagged unusable are left out.
+    """
+    level = "level_g" if "level_g" in table.columns else "level_lbf"
+    ok = ~table["flags"].fillna("").str.contains("unusable")
+    rows = []
+    for (asm), grp in table[ok].groupby("assembly", sort=False):
+        for qty in ("f_res_hz", "zeta_phase_resonance", "zeta_half_power"):
+            ss, dof = 0.0, 0
+            for lev, g in grp.groupby(level, sort=True):
+                v = g[qty].dropna().to_numpy(float)
+                if v.size < 2:
+                    continue
+                sd = float(np.std(v, ddof=1))
+                rel = sd / abs(v.mean())
+                rows.append(dict(assembly=asm, quantity=qty, level=lev, source="repeats" if v.size > 2 else "up_down",
+                                 n=v.size, mean=float(v.mean()), std=sd, rel_std=rel))
+                ss += rel**2 * (v.size - 1)
+                dof += v.size - 1
+            rows.append(dict(assembly=asm, quantity=qty, level=np.nan, source="pooled", n=dof,
+                             mean=np.nan, std=np.nan, rel_std=float(np.sqrt(ss / dof)) if dof else np.nan))
+    out = pd.DataFrame(rows, columns=["assembly", "quantity", "level", "source", "n", "mean", "std", "rel_std"])
+    return out.rename(columns={"level": level})

@@ -1,0 +1,1 @@
+"""Figures and tables of the workflow report (matplotlib imported inside the plotting functions)."""

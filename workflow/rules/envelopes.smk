@@ -1,0 +1,23 @@
+# Stage envelopes: drive-frequency ridge and complex amplitudes per run (jointcal.signal).
+import jointcal
+
+
+rule envelopes_run:
+    input:
+        record=run_record,
+        runs=RESULTS / "ingest" / "runs.csv",
+    output:
+        env=RESULTS / "envelopes" / "{run_id}.csv",
+        meta=RESULTS / "envelopes" / "{run_id}.json",
+    params:
+        version=jointcal.__version__,
+        envelopes=config["envelopes"],
+    log:
+        RESULTS / "logs" / "envelopes" / "{run_id}.log",
+    script:
+        "../scripts/envelopes.py"
+
+
+rule envelopes:
+    input:
+        expand(RESULTS / "envelopes" / "{run_id}.csv", run_id=RUN_IDS),

@@ -1,0 +1,48 @@
+# Stage modal: resonance, damping and amplitude per run, scatter across repeats (jointcal.modal).
+import jointcal
+
+
+rule modal_properties:
+    input:
+        runs=RESULTS / "ingest" / "runs.csv",
+        env=expand(RESULTS / "envelopes" / "{run_id}.csv", run_id=RUN_IDS),
+        meta=expand(RESULTS / "envelopes" / "{run_id}.json", run_id=RUN_IDS),
+        records=list(RUN_FILES.values()),
+    output:
+        table=RESULTS / "modal" / "modal_properties.csv",
+        scatter=RESULTS / "modal" / "scatter.csv",
+    params:
+        version=jointcal.__version__,
+        modal=config["modal"],
+    log:
+        RESULTS / "logs" / "modal.log",
+    script:
+        "../scripts/modal.py"
+
+
+rule modal_figures:
+    input:
+        table=RESULTS / "modal" / "modal_properties.csv",
+        runs=RESULTS / "ingest" / "runs.csv",
+        env=expand(RESULTS / "envelopes" / "{run_id}.csv", run_id=RUN_IDS),
+        records=list(RUN_FILES.values()),
+    output:
+        envelopes=report(RESULTS / "figures" / "fig3_5_envelopes.png",
+                         caption="../report/fig3_5_envelopes.rst", category="Modal properties"),
+        amplitude=report(RESULTS / "figures" / "fig3_6_frequency_damping.png",
+                         caption="../report/fig3_6_frequency_damping.rst", category="Modal properties"),
+        spectrogram=report(RESULTS / "figures" / "spectrogram_ridge.png",
+                           caption="../report/spectrogram_ridge.rst", category="Modal properties"),
+    params:
+        version=jointcal.__version__,
+        envelopes=config["envelopes"],
+    log:
+        RESULTS / "logs" / "modal_figures.log",
+    script:
+        "../scripts/modal_figures.py"
+
+
+rule modal:
+    input:
+        rules.modal_properties.output,
+        rules.modal_figures.output,

@@ -1,0 +1,48 @@
+"""Snakemake script of rule ``modal_properties``: modal_properties.csv and scatter.csv.
+
+Every run gets a row; a run with problems gets flags and a one-sentence warning in the
+log and on stderr, never a silent drop. (No ``from __future__``: see envelopes.py.)
+"""
+import json
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+from jointcal.io import read_run, write_csv_atomic
+from jointcal.modal import FLAG_WORDS, modal_properties, scatter
+
+
+def main(smk) -> None:
+    runs = pd.read_csv(smk.input.runs, dtype={"flags": str})
+    env_dir = Path(smk.input.env[0]).parent
+    raw = {Path(p).name: p for p in smk.input.records}
+    rows, notes = [], []
+    for row in runs.to_dict("records"):
+        rid = row["run_id"]
+        meta = json.loads((env_dir / f"{rid}.json").read_text())
+        env = pd.read_csv(env_dir / f"{rid}.csv")
+        ingest_flags = [f for f in str(row.get("flags") or "").split(";") if f and f != "nan"]
+        if meta.get("error"):
+            out = {k: row.get(k) for k in ("run_id", "assembly", "sequence", "direction")}
+            out["flags"] = ";".join(ingest_flags + ["unusable"])
+            notes.append(f"{rid}: {meta['error']}")
+        else:
+            record = read_run(raw[Path(row["file"]).name]) if Path(row["file"]).name in raw else None
+            out = modal_properties(env, row, rate_hz_per_s=meta["rate_hz_per_s"], record=record, **smk.params.modal)
+            out["flags"] = ";".join(dict.fromkeys(ingest_flags + [f for f in out["flags"].split(";") if f]))
+            out["window_s"] = meta["window_s"]
+        for flag in [f for f in out["flags"].split(";") if f.split(":")[0] in FLAG_WORDS or ":" in f]:
+            notes.append(f"{rid}: {flag.split(':')[0]}: {FLAG_WORDS.get(flag.split(':')[0], flag)}.")
+        rows.append(out)
+    table = pd.DataFrame(rows)
+    write_csv_atomic(table, smk.output.table)
+    write_csv_atomic(scatter(table), smk.output.scatter)
+    lines = [f"jointcal: warning: {n}" for n in notes]
+    for line in lines:
+        print(line, file=sys.stderr)
+    lines.append(f"jointcal: modal properties of {len(table)} runs, {sum(table['flags'].fillna('') != '')} flagged")
+    Path(smk.log[0]).write_text("\n".join(lines) + "\n")
+
+
+main(snakemake)  # noqa: F821

@@ -1,0 +1,29 @@
+"""Snakemake script of rule ``modal_figures``: Figs. 3.5 and 3.6 and a spectrogram. (No ``from __future__``.)"""
+from pathlib import Path
+
+import pandas as pd
+
+from jointcal.io import read_run
+from jointcal.report.modal import plot_envelopes, plot_frequency_damping, plot_spectrogram
+from jointcal.signal import window_length
+
+
+def main(smk) -> None:
+    table = pd.read_csv(smk.input.table, dtype={"flags": str})
+    runs = pd.read_csv(smk.input.runs, dtype={"flags": str}).set_index("run_id", drop=False)
+    envs = {Path(p).stem: pd.read_csv(p) for p in smk.input.env}
+    plot_envelopes(table, envs, smk.output.envelopes)
+    plot_frequency_damping(table, smk.output.amplitude)
+    level = "level_g" if "level_g" in runs.columns else "level_lbf"
+    rid = runs.sort_values([level, "sequence"]).iloc[-1]["run_id"]  # the strongest run
+    row = runs.loc[rid]
+    raw = {Path(p).name: p for p in smk.input.records}
+    lo = min(row["f_start_hz"], row["f_stop_hz"])
+    n = window_length(row["sample_rate_hz"], row["sweep_rate_hz_per_s"], lo, **{
+        k: v for k, v in smk.params.envelopes.items() if k == "zeta_min"})
+    plot_spectrogram(read_run(raw[Path(row["file"]).name]), envs[rid], row["sample_rate_hz"], n, rid,
+                     smk.output.spectrogram)
+    Path(smk.log[0]).write_text(f"jointcal: figures written; spectrogram of {rid}\n")
+
+
+main(snakemake)  # noqa: F821
