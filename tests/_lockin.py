@@ -39,18 +39,22 @@ def linear_sweep(fa, fb, rate, fs, level):
 G = 386.089
 
 
+def nominal_phase(df, row):
+    """Drive phase (rad) and frequency (Hz) of a run's nominal linear sweep, per sample."""
+    t = df["time_s"].to_numpy()
+    f0, f1, rate = row["f_start_hz"], row["f_stop_hz"], row["sweep_rate_hz_per_s"]
+    sgn = 1.0 if f1 > f0 else -1.0
+    tt = np.minimum(t, abs(f1 - f0) / rate)
+    return 2 * np.pi * (f0 * tt + 0.5 * sgn * rate * tt**2), f0 + sgn * rate * tt
+
+
 def run_quadrature(df, row, f_guess, cycles=30):
     """Quadrature frequency (Hz), |z| (in) and |a_base| (g) of one recorded run.
 
     Demodulates at the manifest's nominal sweep; z is the relative acceleration
     (response - base) over -omega^2 at the drive frequency.
     """
-    t = df["time_s"].to_numpy()
-    f0, f1, rate = row["f_start_hz"], row["f_stop_hz"], row["sweep_rate_hz_per_s"]
-    sgn = 1.0 if f1 > f0 else -1.0
-    tt = np.minimum(t, abs(f1 - f0) / rate)
-    phase = 2 * np.pi * (f0 * tt + 0.5 * sgn * rate * tt**2)
-    finst = f0 + sgn * rate * tt
+    phase, finst = nominal_phase(df, row)
     base = df["base_accel_g"].to_numpy()
     rel = df["response_accel_g"].to_numpy() - base
     z = -rel * G / (2 * np.pi * finst) ** 2
@@ -59,12 +63,7 @@ def run_quadrature(df, row, f_guess, cycles=30):
 
 def run_amplitudes(df, row, freqs, cycles=40):
     """Complex response and base amplitudes (g) at the given drive frequencies of a run."""
-    t = df["time_s"].to_numpy()
-    f0, f1, rate = row["f_start_hz"], row["f_stop_hz"], row["sweep_rate_hz_per_s"]
-    sgn = 1.0 if f1 > f0 else -1.0
-    tt = np.minimum(t, abs(f1 - f0) / rate)
-    phase = 2 * np.pi * (f0 * tt + 0.5 * sgn * rate * tt**2)
-    finst = f0 + sgn * rate * tt
+    phase, finst = nominal_phase(df, row)
     nw = int(row["sample_rate_hz"] * cycles / np.mean(freqs))
     B = demodulate(df["base_accel_g"].to_numpy(), phase, nw)
     R = demodulate(df["response_accel_g"].to_numpy(), phase, nw)
