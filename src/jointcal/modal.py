@@ -75,7 +75,8 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
     row : mapping
         Its manifest row.
     rate_hz_per_s : float
-        Measured sweep rate (Hz/s), from the envelopes' ridge.
+        Measured sweep rate (Hz/s), from the envelopes' ridge; the local rate at the
+        crossing (slope of the tracked drive frequency) is used where it is sound.
     mass_lbf : float
         Weight of the moving mass (lbf), used only for force-driven damping.
     record : DataFrame, optional
@@ -132,7 +133,12 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
         near = np.abs(f - f_x) <= max(0.5 * z_guess * f_x, 2.5 * np.median(np.abs(np.diff(f))))
         slope = np.polyfit(f[near], ph[near], 1)[0] if near.sum() >= 3 else (ph[i + 1] - ph[i]) / (f[i + 1] - f[i])
         tau_g = abs(slope) / (2 * np.pi)
-        f_res = f_x - sgn * rate_hz_per_s * tau_g
+        # the local sweep rate at the crossing (controllers deviate from linear sweeps)
+        t_e = e["time_s"].to_numpy()
+        local = np.abs(np.gradient(f, t_e)) if len(f) > 2 else np.array([rate_hz_per_s])
+        rate = float(np.interp(t_x, t_e, local)) if np.all(np.isfinite(local)) else rate_hz_per_s
+        rate = rate if 0 < rate < 10 * rate_hz_per_s else rate_hz_per_s
+        f_res = f_x - sgn * rate * tau_g
         method = "quadrature"
     else:
         flags.append("no_quadrature")
