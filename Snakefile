@@ -3,6 +3,8 @@
 #   ingest     validate the campaign (manifest + run files) -> <results>/ingest/runs.csv
 #   envelopes  drive ridge + complex amplitudes per run     -> <results>/envelopes/<run_id>.csv
 #   modal      resonance, damping, scatter, figures          -> <results>/modal/modal_properties.csv
+#   calibrate  GA (DEAP) on eq. 3.9 per assembly + polish     -> <results>/calibration/<assembly>/ga_best.json
+#   posterior  emcee around the optimum, Table 3.2, Fig. 3.8  -> <results>/posterior/<assembly>/summary.csv
 #
 # Everything:      snakemake --cores 2      (a bare `snakemake` uses profiles/default/)
 # One stage:       snakemake --cores 2 ingest
@@ -22,6 +24,8 @@ include: "workflow/rules/common.smk"
 include: "workflow/rules/ingest.smk"
 include: "workflow/rules/envelopes.smk"
 include: "workflow/rules/modal.smk"
+include: "workflow/rules/calibrate.smk"
+include: "workflow/rules/posterior.smk"
 
 
 rule all:
@@ -29,3 +33,5 @@ rule all:
     input:
         RESULTS / "ingest" / "runs.csv",
         rules.modal.input,
+        rules.calibrate.input,
+        rules.posterior.input,

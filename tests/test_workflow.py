@@ -75,7 +75,9 @@ def test_default_config_runs_on_the_example_campaign(workdir, tmp_path):
     """`snakemake --cores 2` with the default raw_data/ (linked into the copy) runs every stage."""
     (workdir / "raw_data").symlink_to(REPO / "raw_data")
     out = tmp_path / "results"
-    res = _snakemake(workdir, "--cores", "2", "--config", f"results={out}")
+    # a short posterior: this test checks the wiring, test_posterior checks the sampler
+    (workdir / "short.yaml").write_text("posterior: {max_steps: 2000, chunk: 500}\n")
+    res = _snakemake(workdir, "--cores", "2", "--configfile", "short.yaml", "--config", f"results={out}")
     assert res.returncode == 0, res.stderr
     runs = pd.read_csv(out / "ingest" / "runs.csv")
     assert len(runs) == 24 and runs["flags"].isna().all()
@@ -83,3 +85,7 @@ def test_default_config_runs_on_the_example_campaign(workdir, tmp_path):
     modal = pd.read_csv(out / "modal" / "modal_properties.csv")
     assert len(modal) == 24 and modal["f_res_hz"].notna().all()
     assert (out / "figures" / "fig3_5_envelopes.png").is_file()
+    for asm in ("first", "reassembly"):
+        assert (out / "calibration" / asm / "ga_best.json").is_file()
+        assert (out / "posterior" / asm / "summary.csv").is_file()
+    assert (out / "posterior" / "table_3_2.md").is_file()

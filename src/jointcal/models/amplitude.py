@@ -57,6 +57,22 @@ def _J(chi: NDArray, smax: NDArray) -> NDArray:
     return tmax / a * np.sum(_WEIGHTS * (1.0 - jenkins_inphase(s)), axis=-1)
 
 
+def _J_broadcast(chi: NDArray, smax: NDArray) -> NDArray:
+    """`_J` over broadcast arrays, evaluated once per distinct chi where smax = 1 (microslip).
+
+    Below macroslip J depends on chi only; a population of P parameter sets at N
+    amplitudes then needs P quadratures, not P*N. Same values as `_J` bit for bit.
+    """
+    J = np.empty(np.shape(chi))
+    micro = smax >= 1.0
+    if micro.any():
+        values, inverse = np.unique(chi[micro], return_inverse=True)
+        J[micro] = _J(values, np.ones_like(values))[inverse]
+    if not micro.all():
+        J[~micro] = _J(chi[~micro], smax[~micro])
+    return J
+
+
 def _joint(q, Fs, KT, chi, beta):
     q, Fs, KT, chi, beta = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (q, Fs, KT, chi, beta)))
     if np.any(q <= 0):
@@ -117,7 +133,7 @@ def harmonic_balance(q, Fs, KT, chi, beta, k, m, zeta_v, *, viscous: Viscous = "
     """
     q, Fs, KT, chi, beta, phi_max, R, S = _joint(q, Fs, KT, chi, beta)
     smax = np.minimum(1.0, phi_max / q)
-    k_df = k + KT - R * q ** (chi + 1.0) * _J(chi, smax)
+    k_df = k + KT - R * q ** (chi + 1.0) * _J_broadcast(chi, smax)
     k_df = k_df - np.where(q > phi_max, S * (1.0 - jenkins_inphase(phi_max / q)), 0.0)
     omega = np.sqrt(k_df / m)
     omega0 = np.sqrt((k + KT) / m)

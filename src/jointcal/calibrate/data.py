@@ -1,0 +1,184 @@
+"""The calibration's input: one assembly's usable runs from the modal stage's tables.
+
+Reads ``modal_properties.csv`` (one row per run: ``run_id, assembly, q_in, f_res_hz``,
+the damping column named in the config, ``flags``; ``level_g`` or ``level_lbf`` is
+carried along when present) and ``scatter.csv``
+(tidy repeatability: ``assembly, quantity, level_g, source, n, mean, std, rel_std``).
+Rows whose ``flags`` name ``unusable`` are left out; other flags are informational.
+The pooled relative scatter of the frequency and of the chosen damping estimator is the
+likelihood's noise floor; a missing, zero or tiny pooled value is replaced by a floor
+from the config, and the replacement is reported in `ModalData.notes`. Every problem
+raises `CalibrationInputError` with one sentence naming the file, the problem and the fix.
+"""
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Literal, NoReturn
+
+import numpy as np
+import pandas as pd
+from numpy.typing import NDArray
+
+__all__ = ["CalibrationInputError", "ModalData", "DAMPING", "select_modal", "read_modal", "read_table"]
+
+Damping = Literal["zeta_phase_resonance", "zeta_half_power"]
+DAMPING: tuple[str, ...] = ("zeta_phase_resonance", "zeta_half_power")
+FREQUENCY = "f_res_hz"
+_MODAL_COLUMNS = ("run_id", "assembly", "q_in", FREQUENCY, "flags")
+_SCATTER_COLUMNS = ("assembly", "quantity", "source", "rel_std")
+
+
+class CalibrationInputError(ValueError):
+    """A calibration input table breaks its contract (one sentence: file, problem, fix)."""
+
+
+def _fail(where: object, problem: str, fix: str) -> NoReturn:
+    raise CalibrationInputError(f"{where}: {problem}; {fix}.")
+
+
+@dataclass(frozen=True)
+class ModalData:
+    """One assembly's measured resonances (usable runs only, in file order).
+
+    Attributes
+    ----------
+    assembly : str
+    run_id : tuple of str, length N
+    level : ndarray, shape (N,) -- drive level (g, or lbf for force-driven runs); NaN
+        when the table has no level column.
+    q : ndarray, shape (N,) -- relative displacement amplitude at resonance, in.
+    f : ndarray, shape (N,) -- resonance frequency, Hz.
+    zeta : ndarray, shape (N,) -- damping ratio (0.02, not 2%) from ``damping``.
+    damping : str -- the damping column used.
+    rel_noise : (float, float) -- relative noise scale of f and zeta (pooled scatter,
+        floored); NaN when no scatter table was read.
+    notes : tuple of str -- exclusions and floors applied, for the log.
+    """
+
+    assembly: str
+    run_id: tuple[str, ...]
+    level: NDArray[np.float64]
+    q: NDArray[np.float64]
+    f: NDArray[np.float64]
+    zeta: NDArray[np.float64]
+    damping: str
+    rel_noise: tuple[float, float]
+    notes: tuple[str, ...]
+
+
+def _usable(flags: pd.Series) -> NDArray[np.bool_]:
+    text = flags.map(lambda v: "" if pd.isna(v) else str(v))
+    return ~text.map(lambda t: any("unusable" in tok.strip().lower() for tok in t.split(";"))).to_numpy(bool)
+
+
+def _pooled(scatter: pd.DataFrame, assembly: str, quantity: str, floor: float, where: object,
+            notes: list[str]) -> float:
+    rows = scatter[(scatter["assembly"].astype(str) == assembly) & (scatter["quantity"] == quantity)
+                   & (scatter["source"] == "pooled")]
+    value = pd.to_numeric(rows["rel_std"], errors="coerce").to_numpy(float)
+    value = value[np.isfinite(value)]
+    if value.size == 0 or value[0] <= 0:
+        notes.append(f"{where}: no positive pooled rel_std of {quantity} for assembly {assembly!r}; "
+                     f"using the floor {floor:g}")
+        return float(floor)
+    if value[0] < floor:
+        notes.append(f"{where}: pooled rel_std of {quantity} for assembly {assembly!r} is {value[0]:.3g}, "
+                     f"below the floor; using {floor:g}")
+        return float(floor)
+    return float(value[0])
+
+
+def select_modal(modal: pd.DataFrame, assembly: str, *, damping: Damping = "zeta_phase_resonance",
+                 scatter: pd.DataFrame | None = None, floors: Mapping[str, float] | None = None,
+                 modal_name: object = "modal_properties.csv", scatter_name: object = "scatter.csv") -> ModalData:
+    """Validate the modal tables and return one assembly's usable runs.
+
+    Parameters
+    ----------
+    modal : pandas.DataFrame
+        The modal-properties table (see module notes).
+    assembly : str
+        Assembly to select.
+    damping : {'zeta_phase_resonance', 'zeta_half_power'}
+        Damping estimator (half power reproduces the paper).
+    scatter : pandas.DataFrame, optional
+        The scatter table; without it ``rel_noise`` is (NaN, NaN).
+    floors : mapping, optional
+        ``{'frequency': 1e-4, 'damping': 0.01}``: smallest relative noise scales.
+    modal_name, scatter_name : object
+        How the files are named in error messages and notes.
+
+    Returns
+    -------
+    ModalData
+
+    Raises
+    ------
+    CalibrationInputError
+        Missing column, unknown assembly, every run flagged unusable, or a missing,
+        non-numeric or non-positive q_in / f_res_hz / damping value in a usable run.
+    """
+    if damping not in DAMPING:
+        raise ValueError(f"damping must be one of {', '.join(DAMPING)}, got {damping!r}")
+    need = [*_MODAL_COLUMNS, damping]
+    missing = [c for c in need if c not in modal.columns]
+    if missing:
+        _fail(modal_name, f"column(s) {', '.join(missing)} missing (found: {', '.join(map(str, modal.columns))})",
+              "regenerate it with the modal stage")
+    rows = modal[modal["assembly"].astype(str) == str(assembly)]
+    if rows.empty:
+        found = ", ".join(sorted(map(str, modal["assembly"].unique()))) or "none"
+        _fail(modal_name, f"it has no runs of assembly {assembly!r} (assemblies: {found})",
+              "check the assembly name or rerun the modal stage")
+    keep = _usable(rows["flags"])
+    notes = [f"{modal_name}: {int((~keep).sum())} of {len(rows)} runs of {assembly!r} flagged unusable, left out"]
+    if not keep.any():
+        _fail(modal_name, f"all {len(rows)} runs of assembly {assembly!r} are flagged unusable",
+              "fix the flagged runs or the modal settings; nothing is left to calibrate")
+    rows = rows[keep]
+    values = {}
+    for col in ("q_in", FREQUENCY, damping):
+        v = pd.to_numeric(rows[col], errors="coerce").to_numpy(float)
+        bad = ~(np.isfinite(v) & (v > 0))
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            _fail(modal_name, f"run {rows['run_id'].tolist()[i]!r} has {col} = {rows[col].tolist()[i]}, "
+                  "not a positive number", "flag the run unusable or rerun the modal stage")
+        values[col] = v
+    level_col = next((c for c in ("level_g", "level_lbf") if c in rows.columns), None)
+    level = (np.full(len(rows), np.nan) if level_col is None
+             else pd.to_numeric(rows[level_col], errors="coerce").to_numpy(float))
+    floors = {"frequency": 1e-4, "damping": 0.01, **(floors or {})}
+    noise = (float("nan"), float("nan"))
+    if scatter is not None:
+        missing = [c for c in _SCATTER_COLUMNS if c not in scatter.columns]
+        if missing:
+            _fail(scatter_name, f"column(s) {', '.join(missing)} missing "
+                  f"(found: {', '.join(map(str, scatter.columns))})", "regenerate it with the modal stage")
+        noise = (_pooled(scatter, str(assembly), FREQUENCY, floors["frequency"], scatter_name, notes),
+                 _pooled(scatter, str(assembly), damping, floors["damping"], scatter_name, notes))
+    return ModalData(assembly=str(assembly), run_id=tuple(map(str, rows["run_id"])), level=level,
+                     q=values["q_in"], f=values[FREQUENCY], zeta=values[damping], damping=damping,
+                     rel_noise=noise, notes=tuple(notes))
+
+
+def read_table(path: str | os.PathLike[str]) -> pd.DataFrame:
+    """Read a CSV table, raising `CalibrationInputError` naming the file if it cannot."""
+    path = Path(path)
+    if not path.is_file():
+        _fail(path, "the file does not exist", "run the stage that writes it first")
+    try:
+        return pd.read_csv(path, keep_default_na=True)
+    except (ValueError, UnicodeDecodeError, pd.errors.ParserError) as exc:
+        _fail(path, f"cannot be read as CSV ({exc})", "regenerate it")
+
+
+def read_modal(modal_csv: str | os.PathLike[str], assembly: str, *, scatter_csv: str | os.PathLike[str] | None = None,
+               damping: Damping = "zeta_phase_resonance", floors: Mapping[str, float] | None = None) -> ModalData:
+    """`select_modal` on the files ``modal_properties.csv`` (and ``scatter.csv``)."""
+    scatter = None if scatter_csv is None else read_table(scatter_csv)
+    return select_modal(read_table(modal_csv), assembly, damping=damping, scatter=scatter, floors=floors,
+                        modal_name=Path(modal_csv), scatter_name=None if scatter_csv is None else Path(scatter_csv))

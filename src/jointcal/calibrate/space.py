@@ -1,0 +1,116 @@
+"""The calibration's parameter space: six joint parameters, bounds and their scaling.
+
+The GA's genes and the posterior's coordinates are the same normalised space u in
+[0, 1]^6 (one column per parameter in `PARAMS` order). A positive scale parameter
+(Fs, KT, k, zeta_v) and the shape ratio beta are mapped logarithmically between their
+bounds, chi linearly:
+
+    x = log10(p) (log) or p (linear);  u = (x - x_lo) / (x_hi - x_lo).
+
+beta is log-scaled with a small positive floor (default 1e-4) rather than linear in
+[0, beta_max]: the paper's values (0.004, 0.025) are an order of magnitude apart, and a
+log scale gives each decade the same prior mass and GA resolution. beta below the floor
+is indistinguishable from 0: c = beta + (chi+1)/(chi+2) >= 0.048 for chi >= -0.95, so
+beta = 1e-4 changes c, phi_max, R and S by at most 0.2% (eqs. 3.5-3.7).
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+__all__ = ["PARAMS", "UNITS", "LOG_SCALED", "ParamSpace"]
+
+PARAMS: tuple[str, ...] = ("Fs", "KT", "chi", "beta", "k", "zeta_v")
+UNITS: dict[str, str] = {"Fs": "lbf", "KT": "lbf/in", "chi": "-", "beta": "-", "k": "lbf/in", "zeta_v": "-"}
+LOG_SCALED: dict[str, bool] = {"Fs": True, "KT": True, "chi": False, "beta": True, "k": True, "zeta_v": True}
+
+
+@dataclass(frozen=True)
+class ParamSpace:
+    """Bounds of (Fs, KT, chi, beta, k, zeta_v) and the map to the unit cube.
+
+    Parameters
+    ----------
+    lo, hi : tuple of float, length 6
+        Lower and upper bounds in physical units (lbf, lbf/in, -, -, lbf/in, -), in
+        `PARAMS` order. Log-scaled parameters need 0 < lo < hi; chi needs
+        -1 < lo < hi <= 0.
+    """
+
+    lo: tuple[float, ...]
+    hi: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        if len(self.lo) != len(PARAMS) or len(self.hi) != len(PARAMS):
+            raise ValueError(f"bounds need {len(PARAMS)} values each ({', '.join(PARAMS)}), "
+                             f"got {len(self.lo)} and {len(self.hi)}")
+        for name, a, b in zip(PARAMS, self.lo, self.hi):
+            if not (np.isfinite(a) and np.isfinite(b) and a < b):
+                raise ValueError(f"bounds of {name}: need finite lower < upper, got [{a!r}, {b!r}]")
+            if LOG_SCALED[name] and a <= 0:
+                raise ValueError(f"bounds of {name}: it is log-scaled, so the lower bound must be > 0, got {a!r}")
+        chi = PARAMS.index("chi")
+        if not (-1.0 < self.lo[chi] and self.hi[chi] <= 0.0):
+            raise ValueError(f"bounds of chi must lie in (-1, 0], got [{self.lo[chi]!r}, {self.hi[chi]!r}]")
+
+    @classmethod
+    def from_bounds(cls, bounds: Mapping[str, ArrayLike]) -> ParamSpace:
+        """Build from a mapping ``{name: [lower, upper]}`` (the config's ``bounds``)."""
+        missing = [p for p in PARAMS if p not in bounds]
+        extra = [p for p in bounds if p not in PARAMS]
+        if missing or extra:
+            raise ValueError(f"bounds must name exactly {', '.join(PARAMS)} "
+                             f"(missing: {', '.join(missing) or 'none'}; unknown: {', '.join(extra) or 'none'})")
+        pairs = [tuple(float(v) for v in bounds[p]) for p in PARAMS]
+        if any(len(p) != 2 for p in pairs):
+            raise ValueError("each bound must be a [lower, upper] pair")
+        return cls(tuple(p[0] for p in pairs), tuple(p[1] for p in pairs))
+
+    @property
+    def ndim(self) -> int:
+        """Number of parameters (6)."""
+        return len(PARAMS)
+
+    @property
+    def is_log(self) -> NDArray[np.bool_]:
+        """Which parameters are log10-scaled, shape (6,)."""
+        return np.array([LOG_SCALED[p] for p in PARAMS])
+
+    @property
+    def x_lo(self) -> NDArray[np.float64]:
+        """Lower bounds in the sampling space x (log10 or linear), shape (6,)."""
+        return np.array([np.log10(v) if LOG_SCALED[p] else v for p, v in zip(PARAMS, self.lo)])
+
+    @property
+    def x_hi(self) -> NDArray[np.float64]:
+        """Upper bounds in the sampling space x, shape (6,)."""
+        return np.array([np.log10(v) if LOG_SCALED[p] else v for p, v in zip(PARAMS, self.hi)])
+
+    @property
+    def x_names(self) -> tuple[str, ...]:
+        """Names of the sampling-space coordinates, e.g. ``log10_Fs`` and ``chi``."""
+        return tuple(f"log10_{p}" if LOG_SCALED[p] else p for p in PARAMS)
+
+    def to_physical(self, u: ArrayLike) -> NDArray[np.float64]:
+        """Unit-cube coordinates (..., 6) to physical parameters (..., 6)."""
+        x = self.x_lo + np.asarray(u, dtype=float) * (self.x_hi - self.x_lo)
+        return np.where(self.is_log, 10.0**x, x)
+
+    def to_unit(self, p: ArrayLike) -> NDArray[np.float64]:
+        """Physical parameters (..., 6) to unit-cube coordinates (..., 6) (not clipped)."""
+        p = np.asarray(p, dtype=float)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x = np.where(self.is_log, np.log10(np.where(p > 0, p, np.nan)), p)
+        return (x - self.x_lo) / (self.x_hi - self.x_lo)
+
+    def unit_to_x(self, u: ArrayLike) -> NDArray[np.float64]:
+        """Unit-cube coordinates to the sampling space x (log10 or linear)."""
+        return self.x_lo + np.asarray(u, dtype=float) * (self.x_hi - self.x_lo)
+
+    def inside(self, u: ArrayLike) -> NDArray[np.bool_]:
+        """True where a point (..., 6) of the unit cube lies within the bounds (and is finite)."""
+        u = np.asarray(u, dtype=float)
+        return np.all(np.isfinite(u) & (u >= 0.0) & (u <= 1.0), axis=-1)

@@ -1,0 +1,148 @@
+"""emcee run in chunks until the chain is long compared with its autocorrelation time.
+
+After each chunk the integrated autocorrelation time tau of every coordinate is read from
+the whole chain so far with `emcee.autocorr.integrated_time(chain, tol=0)` (what
+`EnsembleSampler.get_autocorr_time(tol=0)` computes, here over the chunks of earlier
+processes too). The run stops when the chain is longer than ``tau_factor * max(tau)``
+and every tau changed by less than ``tau_rtol`` since the previous chunk, or at
+``max_steps``.
+
+Reproducible: emcee draws from its own ``numpy.random.RandomState``, set from `seed`
+through the initial `emcee.State` (not from numpy's global state). Resumable: after
+every chunk `on_chunk` receives the chain so far, the last log-probabilities and the
+RandomState; passing that back as `resume` continues the chain exactly where it stopped,
+so an interrupted run ends with the same chain as an uninterrupted one.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import emcee
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["ChainResult", "run_chain", "random_state_arrays", "random_state_tuple"]
+
+
+@dataclass
+class ChainResult:
+    """An emcee chain and its convergence record.
+
+    chain : ndarray (steps, walkers, ndim); log_prob : ndarray (steps, walkers);
+    tau : ndarray (ndim [+ k],) -- integrated autocorrelation time of each coordinate
+    (and observed quantity), steps; tau_history : ndarray (chunks, 1 + len(tau)) -- chain
+    length, then tau, after each chunk;
+    converged : bool -- the 50-tau rule was met; acceptance : ndarray (walkers,) --
+    acceptance fraction over the whole chain; random_state : tuple -- emcee's RandomState.
+    """
+
+    chain: NDArray[np.float64]
+    log_prob: NDArray[np.float64]
+    tau: NDArray[np.float64]
+    tau_history: NDArray[np.float64]
+    converged: bool
+    acceptance: NDArray[np.float64]
+    random_state: tuple
+
+    @property
+    def steps(self) -> int:
+        """Chain length, steps."""
+        return int(self.chain.shape[0])
+
+
+def random_state_arrays(state: tuple) -> dict[str, NDArray]:
+    """A ``RandomState.get_state()`` tuple as plain arrays (for ``numpy.savez``)."""
+    _, keys, pos, has_gauss, cached = state
+    return {"rs_keys": np.asarray(keys, dtype=np.uint32), "rs_pos": np.asarray(pos, dtype=np.int64),
+            "rs_has_gauss": np.asarray(has_gauss, dtype=np.int64), "rs_cached": np.asarray(cached, dtype=float)}
+
+
+def random_state_tuple(arrays: dict[str, NDArray]) -> tuple:
+    """Inverse of `random_state_arrays`."""
+    return ("MT19937", np.asarray(arrays["rs_keys"], dtype=np.uint32), int(arrays["rs_pos"]),
+            int(arrays["rs_has_gauss"]), float(arrays["rs_cached"]))
+
+
+def _tau(chain: NDArray[np.float64], observe: Callable | None) -> NDArray[np.float64]:
+    if observe is not None:
+        chain = np.concatenate([chain, observe(chain)], axis=-1)
+    return emcee.autocorr.integrated_time(chain, tol=0)
+
+
+def run_chain(log_prob: Callable[[NDArray[np.float64]], NDArray[np.float64]], x0: NDArray[np.float64], *,
+              seed: int, max_steps: int, chunk: int = 1000, tau_factor: float = 50.0, tau_rtol: float = 0.05,
+              observe: Callable[[NDArray[np.float64]], NDArray[np.float64]] | None = None,
+              resume: dict[str, Any] | None = None,
+              on_chunk: Callable[[dict[str, Any]], None] | None = None) -> ChainResult:
+    """Run an affine-invariant ensemble (emcee) with a vectorised log-probability.
+
+    Parameters
+    ----------
+    log_prob : callable
+        ``log_prob(X) -> (W,)`` for X of shape (W, ndim); -inf outside the prior.
+    x0 : ndarray, shape (walkers, ndim)
+        Starting positions (used only when not resuming).
+    seed : int
+        Seed of emcee's RandomState.
+    max_steps : int
+        Hard cap on the chain length, steps.
+    chunk : int
+        Steps between convergence checks and `on_chunk` calls.
+    tau_factor, tau_rtol : float
+        Stop when steps > tau_factor * max(tau) and max |delta tau / tau| < tau_rtol.
+    observe : callable, optional
+        ``observe(chain) -> (steps, walkers, k)``: further quantities (e.g. the
+        physical parameters) whose tau also counts in the stopping rule; tau then has
+        ndim + k entries.
+    resume : dict, optional
+        A dict given earlier to `on_chunk` (keys chain, log_prob, random_state,
+        tau_history, accepted); the chain continues from its last step.
+    on_chunk : callable, optional
+        Called after each chunk with that dict.
+
+    Returns
+    -------
+    ChainResult
+    """
+    if resume is not None and len(resume["chain"]):
+        chain, lp = np.asarray(resume["chain"]), np.asarray(resume["log_prob"])
+        hist = [np.asarray(h) for h in resume["tau_history"]]
+        accepted = np.asarray(resume["accepted"], dtype=float)
+        state = emcee.State(chain[-1], log_prob=lp[-1], random_state=resume["random_state"])
+    else:
+        x0 = np.asarray(x0, dtype=float)
+        chain, lp = np.zeros((0, *x0.shape)), np.zeros((0, x0.shape[0]))
+        hist, accepted = [], np.zeros(x0.shape[0])
+        state = emcee.State(x0, random_state=np.random.RandomState(seed).get_state())
+    nwalkers, ndim = chain.shape[1:] if chain.size else np.shape(state.coords)
+    sampler = emcee.EnsembleSampler(nwalkers, ndim, log_prob, vectorize=True)
+    tau = _tau(chain, observe) if len(chain) else np.full(ndim, np.inf)
+    converged = _converged(hist, tau_factor, tau_rtol)
+    while not converged and len(chain) < max_steps:
+        n = int(min(chunk, max_steps - len(chain)))
+        sampler.reset()
+        state = sampler.run_mcmc(state, n, skip_initial_state_check=len(chain) > 0)
+        chain = np.concatenate([chain, sampler.get_chain()])
+        lp = np.concatenate([lp, sampler.get_log_prob()])
+        accepted = accepted + sampler.backend.accepted
+        tau = _tau(chain, observe)
+        hist.append(np.r_[len(chain), tau])
+        converged = _converged(hist, tau_factor, tau_rtol)
+        if on_chunk is not None:
+            on_chunk(dict(chain=chain, log_prob=lp, random_state=state.random_state, tau_history=hist,
+                          accepted=accepted))
+    rs = state.random_state if state.random_state is not None else sampler.random_state
+    return ChainResult(chain=chain, log_prob=lp, tau=tau, tau_history=np.asarray(hist).reshape(len(hist), -1),
+                       converged=converged, acceptance=accepted / max(len(chain), 1), random_state=rs)
+
+
+def _converged(hist: list[NDArray[np.float64]], tau_factor: float, tau_rtol: float) -> bool:
+    """The 50-tau rule on the last two convergence checks."""
+    if len(hist) < 2:
+        return False
+    (n, *tau), (_, *prev) = hist[-1], hist[-2]
+    tau, prev = np.asarray(tau), np.asarray(prev)
+    return bool(np.all(np.isfinite(tau)) and n > tau_factor * tau.max()
+                and np.all(np.abs(tau - prev) / tau < tau_rtol))

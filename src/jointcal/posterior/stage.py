@@ -1,0 +1,162 @@
+"""The posterior stage on files: start at the GA optimum, run emcee with checkpoints, write summaries.
+
+Outputs in ``out_dir`` (all written atomically):
+
+* ``summary.csv`` -- `jointcal.posterior.summary.summarize` (param, unit, median, q05,
+  q95, tau, n_eff, prior_lo, prior_hi, width_ratio, constrained);
+* ``chain.npz`` -- ``chain`` (steps, walkers, 8) in the sampler coordinates ``names``,
+  ``log_prob`` (steps, walkers), ``samples`` (draws, 8): burned-in, thinned draws of
+  (Fs, KT, chi, beta, k, zeta_v, sigma_f, sigma_zeta) in physical units (``sample_names``),
+  ``tau_history`` (chunks, 1 + n): chain length then tau, ``q_ref`` (in), ``burn``,
+  ``converged`` and emcee's RandomState (``rs_*``);
+* ``constraints.txt`` -- convergence, then one sentence per parameter and correlation;
+* ``predictive.csv`` -- q_in, f_q05, f_q50, f_q95, zeta_q05, zeta_q50, zeta_q95.
+
+The checkpoint (the same arrays, rewritten after every chunk) lives outside the declared
+outputs, which Snakemake deletes before a rerun; it carries a fingerprint of the data,
+the GA optimum and the settings that shape the chain, and is ignored when they differ.
+"""
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ..calibrate.data import CalibrationInputError, read_modal
+from ..calibrate.settings import CalibrateSettings
+from ..calibrate.space import PARAMS
+from ..io import write_bytes_atomic, write_csv_atomic
+from .likelihood import LogPosterior
+from .sampler import ChainResult, random_state_arrays, random_state_tuple, run_chain
+from .settings import PosteriorSettings
+from .summary import NAMES, burn_in, constraints_text, predictive_band, summarize
+
+__all__ = ["OUTPUTS", "start_ball", "run_posterior"]
+
+OUTPUTS = ("summary.csv", "chain.npz", "constraints.txt", "predictive.csv")
+
+
+def start_ball(lp: LogPosterior, theta: np.ndarray, ps: PosteriorSettings) -> np.ndarray:
+    """Walkers (n_walkers, 8) in sampler coordinates: a small ball around the GA optimum, inside the bounds."""
+    x = lp.space.to_unit(theta) * (lp.space.x_hi - lp.space.x_lo) + lp.space.x_lo
+    r_f, r_z = lp.residuals(x[None])
+    noise = np.log10([np.sqrt(np.mean(r_f**2)), np.sqrt(np.mean(r_z**2))])
+    x = np.r_[x, noise]
+    width = lp.upper - lp.lower
+    margin = 3.0 * ps.ball * width  # a centre on a bound (e.g. beta at its floor) moves in, so no walker is clipped
+    x = np.clip(np.where(np.isfinite(x), x, lp.lower), lp.lower + margin, lp.upper - margin)
+    rng = np.random.default_rng(ps.seed)
+    x0 = x + ps.ball * width * rng.standard_normal((ps.n_walkers, lp.ndim))
+    x0 = np.clip(x0, lp.lower + 1e-9 * width, lp.upper - 1e-9 * width)
+    return lp.to_y(x0)
+
+
+def _npz(arrays: dict) -> bytes:
+    buf = io.BytesIO()
+    np.savez(buf, **arrays)
+    return buf.getvalue()
+
+
+def run_posterior(modal_csv: str | os.PathLike[str], scatter_csv: str | os.PathLike[str],
+                  ga_best_json: str | os.PathLike[str], assembly: str, out_dir: str | os.PathLike[str],
+                  cal: CalibrateSettings, ps: PosteriorSettings, *,
+                  checkpoint: str | os.PathLike[str] | None = None) -> tuple[ChainResult, list[str]]:
+    """Sample one assembly's posterior and write the stage's outputs.
+
+    Parameters
+    ----------
+    modal_csv, scatter_csv : path-like
+        The modal stage's tables.
+    ga_best_json : path-like
+        The calibration stage's ``ga_best.json`` for this assembly (the start).
+    assembly : str
+    out_dir : path-like
+        Folder for `OUTPUTS` (created).
+    cal, ps : CalibrateSettings, PosteriorSettings
+    checkpoint : path-like, optional
+        ``.npz`` checkpoint: resumed from when it matches, rewritten after every chunk.
+
+    Returns
+    -------
+    result : ChainResult
+    notes : list of str
+        Lines for the log (floors used, resume, convergence).
+    """
+    floors = dict(ps.rel_std_floor)
+    data = read_modal(modal_csv, assembly, scatter_csv=scatter_csv, damping=cal.damping,  # type: ignore[arg-type]
+                      floors=floors)
+    notes = list(data.notes)
+    best = json.loads(Path(ga_best_json).read_text())
+    for key in ("model", "viscous", "damping"):
+        if best.get(key) != getattr(cal, key):
+            raise CalibrationInputError(f"{ga_best_json}: it was calibrated with {key} {best.get(key)!r}, "
+                                        f"the config now says {getattr(cal, key)!r}; rerun the calibrate stage.")
+    theta = np.array([best[p] for p in PARAMS], dtype=float)
+    noise_max = (ps.noise_max["frequency"], ps.noise_max["damping"])
+    lp = LogPosterior(data, cal.space, cal.m, cal.model, cal.viscous, noise_max)
+    y0 = start_ball(lp, theta, ps)
+    shape = dict(theta=theta.tolist(), seed=ps.seed, walkers=ps.n_walkers, ball=ps.ball, floors=floors,
+                 noise_max=noise_max, cal=[cal.model, cal.viscous, cal.damping, cal.m,
+                                           {k: list(map(float, v)) for k, v in cal.bounds.items()}])
+    fp = hashlib.sha256(json.dumps(shape, sort_keys=True).encode())
+    for a in (data.q, data.f, data.zeta):
+        fp.update(a.tobytes())
+    fingerprint = fp.hexdigest()
+    resume = None
+    ckpt = None if checkpoint is None else Path(checkpoint)
+    if ckpt is not None and ckpt.is_file():
+        try:
+            with np.load(ckpt) as z:
+                saved = {k: z[k] for k in z.files}
+        except Exception as exc:  # a damaged checkpoint only costs the time to recompute
+            saved = {}
+            notes.append(f"{ckpt}: unreadable checkpoint ({type(exc).__name__}); starting afresh")
+        if saved and str(saved.get("fingerprint")) == fingerprint:
+            resume = dict(chain=saved["chain"], log_prob=saved["log_prob"], tau_history=list(saved["tau_history"]),
+                          accepted=saved["accepted"], random_state=random_state_tuple(saved))
+            notes.append(f"{ckpt}: resuming the chain after {len(saved['chain'])} steps")
+        elif saved:
+            notes.append(f"{ckpt}: checkpoint made with other data or settings; starting afresh")
+
+    def arrays(chain, log_prob, random_state, tau_history, accepted) -> dict:
+        return dict(chain=chain, log_prob=log_prob, tau_history=np.asarray(tau_history), accepted=accepted,
+                    names=np.array(lp.names), q_ref=lp.q_ref, fingerprint=np.array(fingerprint),
+                    **random_state_arrays(random_state))
+
+    def save(state: dict) -> None:
+        write_bytes_atomic(_npz(arrays(**state)), ckpt)  # type: ignore[arg-type]
+
+    res = run_chain(lp, y0, seed=ps.seed, max_steps=ps.max_steps, chunk=ps.chunk, tau_factor=ps.tau_factor,
+                    tau_rtol=ps.tau_rtol, observe=lambda c: lp.to_x(c)[..., [0, 1, 3, 4]], resume=resume,
+                    on_chunk=None if ckpt is None else save)
+    chain_x = lp.to_x(res.chain)
+    burn = burn_in(res.tau, res.steps, ps.burn_tau)
+    summary = summarize(chain_x, lp.lower, lp.upper, burn=burn, ratio=ps.constrained_ratio)
+    kept = chain_x[burn:].reshape(-1, lp.ndim)
+    step = max(1, len(kept) // ps.predictive_draws)
+    samples = lp.physical(kept[::step][: ps.predictive_draws])
+    q = np.geomspace(data.q.min() / cal.curve_widen, data.q.max() * cal.curve_widen, cal.curve_points)
+    band = predictive_band(samples[:, :6], q, m=cal.m, model=cal.model, viscous=cal.viscous)
+    tmax = float(np.max(res.tau))
+    head = (f"emcee: {ps.n_walkers} walkers, {res.steps} steps = {res.steps / tmax:.1f} x the largest "
+            f"autocorrelation time ({tmax:.0f} steps); " + ("converged by the 50-tau rule" if res.converged else
+            f"NOT converged: stopped at max_steps {ps.max_steps}; treat the intervals as provisional") +
+            f"; burn-in {burn} steps; mean acceptance {np.mean(res.acceptance):.2f}.")
+    text = head + "\n" + constraints_text(summary, chain_x, burn=burn, q_max=float(data.q.max()),
+                                          ratio=ps.constrained_ratio)
+    out = Path(out_dir)
+    write_csv_atomic(summary, out / "summary.csv")
+    final = arrays(res.chain, res.log_prob, res.random_state, res.tau_history, res.acceptance * res.steps)
+    final.update(samples=samples, sample_names=np.array(NAMES), burn=burn, converged=res.converged)
+    write_bytes_atomic(_npz(final), out / "chain.npz")
+    (out / "constraints.txt").parent.mkdir(parents=True, exist_ok=True)
+    write_bytes_atomic(text.encode(), out / "constraints.txt")
+    write_csv_atomic(band, out / "predictive.csv")
+    notes.append(head)
+    notes.append(f"noise floors (relative): frequency {data.rel_noise[0]:.3g}, damping {data.rel_noise[1]:.3g}")
+    return res, notes
+

@@ -1,0 +1,59 @@
+# Stage calibrate: GA (DEAP) per assembly on the paper's eq. 3.9 (jointcal.calibrate), and its figures.
+# GA checkpoints live in <results>/checkpoints/ (not declared outputs: Snakemake deletes
+# those before a rerun, and an interrupted GA resumes from its checkpoint).
+import re
+
+import jointcal
+
+CALIBRATION = RESULTS / "calibration"
+ASSEMBLY_RE = "|".join(re.escape(a) for a in ASSEMBLIES) or "no-assembly"
+
+
+rule calibrate_assembly:
+    input:
+        modal=RESULTS / "modal" / "modal_properties.csv",
+    output:
+        best=CALIBRATION / "{assembly}" / "ga_best.json",
+        history=CALIBRATION / "{assembly}" / "ga_history.csv",
+        logbook=CALIBRATION / "{assembly}" / "ga_logbook.csv",
+        curves=CALIBRATION / "{assembly}" / "model_curves.csv",
+    params:
+        version=jointcal.__version__,  # src/ edits do not rerun rules: a version bump does
+        calibrate=config.get("calibrate", {}),
+        checkpoint=lambda wc: str(RESULTS / "checkpoints" / "calibration" / f"{wc.assembly}.pkl"),
+    wildcard_constraints:
+        assembly=ASSEMBLY_RE,
+    threads: 1
+    log:
+        RESULTS / "logs" / "calibrate" / "{assembly}.log",
+    script:
+        "../scripts/calibrate.py"
+
+
+rule calibration_figures:
+    input:
+        history=CALIBRATION / "{assembly}" / "ga_history.csv",
+        logbook=CALIBRATION / "{assembly}" / "ga_logbook.csv",
+    output:
+        exploration=report(RESULTS / "figures" / "ga_exploration_{assembly}.png",
+                           caption="../report/ga_exploration.rst", category="Calibration",
+                           subcategory="{assembly}"),
+        convergence=report(RESULTS / "figures" / "ga_convergence_{assembly}.png",
+                           caption="../report/ga_convergence.rst", category="Calibration",
+                           subcategory="{assembly}"),
+    params:
+        version=jointcal.__version__,
+    wildcard_constraints:
+        assembly=ASSEMBLY_RE,
+    threads: 1
+    log:
+        RESULTS / "logs" / "calibration_figures" / "{assembly}.log",
+    script:
+        "../scripts/calibration_figures.py"
+
+
+rule calibrate:
+    input:
+        expand(CALIBRATION / "{assembly}" / "ga_best.json", assembly=ASSEMBLIES),
+        expand(RESULTS / "figures" / "ga_exploration_{assembly}.png", assembly=ASSEMBLIES),
+        expand(RESULTS / "figures" / "ga_convergence_{assembly}.png", assembly=ASSEMBLIES),

@@ -1,0 +1,79 @@
+# Stage posterior: emcee around each GA optimum (jointcal.posterior); corner plots, Fig. 3.8, Table 3.2.
+# Include after calibrate.smk (uses its ASSEMBLY_RE).
+# Chain checkpoints live in <results>/checkpoints/ (not declared outputs: an interrupted
+# chain resumes from its last chunk).
+import jointcal
+
+POSTERIOR = RESULTS / "posterior"
+
+
+rule posterior_assembly:
+    input:
+        modal=RESULTS / "modal" / "modal_properties.csv",
+        scatter=RESULTS / "modal" / "scatter.csv",
+        best=RESULTS / "calibration" / "{assembly}" / "ga_best.json",
+    output:
+        summary=POSTERIOR / "{assembly}" / "summary.csv",
+        chain=POSTERIOR / "{assembly}" / "chain.npz",
+        constraints=POSTERIOR / "{assembly}" / "constraints.txt",
+        predictive=POSTERIOR / "{assembly}" / "predictive.csv",
+    params:
+        version=jointcal.__version__,
+        calibrate=config.get("calibrate", {}),
+        posterior=config.get("posterior", {}),
+        checkpoint=lambda wc: str(RESULTS / "checkpoints" / "posterior" / f"{wc.assembly}.npz"),
+    wildcard_constraints:
+        assembly=ASSEMBLY_RE,
+    threads: 1
+    log:
+        RESULTS / "logs" / "posterior" / "{assembly}.log",
+    script:
+        "../scripts/posterior.py"
+
+
+rule posterior_corner:
+    input:
+        chain=POSTERIOR / "{assembly}" / "chain.npz",
+    output:
+        corner=report(RESULTS / "figures" / "corner_{assembly}.png", caption="../report/corner.rst",
+                      category="Posterior", subcategory="{assembly}"),
+    params:
+        version=jointcal.__version__,
+    wildcard_constraints:
+        assembly=ASSEMBLY_RE,
+    threads: 1
+    log:
+        RESULTS / "logs" / "posterior_corner" / "{assembly}.log",
+    script:
+        "../scripts/posterior_corner.py"
+
+
+rule posterior_report:
+    input:
+        modal=RESULTS / "modal" / "modal_properties.csv",
+        best=expand(RESULTS / "calibration" / "{assembly}" / "ga_best.json", assembly=ASSEMBLIES),
+        curves=expand(RESULTS / "calibration" / "{assembly}" / "model_curves.csv", assembly=ASSEMBLIES),
+        summary=expand(POSTERIOR / "{assembly}" / "summary.csv", assembly=ASSEMBLIES),
+        predictive=expand(POSTERIOR / "{assembly}" / "predictive.csv", assembly=ASSEMBLIES),
+    output:
+        figure=report(RESULTS / "figures" / "fig3_8_amplitude_fit.png", caption="../report/fig3_8_amplitude_fit.rst",
+                      category="Posterior"),
+        table=POSTERIOR / "table_3_2.csv",
+        markdown=report(POSTERIOR / "table_3_2.md", caption="../report/table_3_2.rst", category="Posterior"),
+        qsma=POSTERIOR / "qsma_vs_harmonic_balance.csv",
+    params:
+        version=jointcal.__version__,
+        calibrate=config.get("calibrate", {}),
+        assemblies=ASSEMBLIES,
+    threads: 1
+    log:
+        RESULTS / "logs" / "posterior_report.log",
+    script:
+        "../scripts/posterior_report.py"
+
+
+rule posterior:
+    input:
+        expand(POSTERIOR / "{assembly}" / "summary.csv", assembly=ASSEMBLIES),
+        expand(RESULTS / "figures" / "corner_{assembly}.png", assembly=ASSEMBLIES),
+        rules.posterior_report.output,
