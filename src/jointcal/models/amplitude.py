@@ -31,7 +31,7 @@ __all__ = ["jenkins_inphase", "qsma", "harmonic_balance", "resonance_amplitude",
 G = 386.089  # in/s^2 per g
 Viscous = Literal["dashpot", "constant"]
 
-_NODES, _WEIGHTS = np.polynomial.legendre.leggauss(96)
+_NODES, _WEIGHTS = np.polynomial.legendre.leggauss(16)
 _NODES = 0.5 * (_NODES + 1.0)
 _WEIGHTS = 0.5 * _WEIGHTS
 
@@ -49,12 +49,24 @@ def jenkins_inphase(s: ArrayLike) -> NDArray[np.float64]:
 
 
 def _J(chi: NDArray, smax: NDArray) -> NDArray:
-    """J = int_0^smax (1 - g(s)) s**chi ds, by Gauss-Legendre in t = s**(chi+1)."""
+    """J = int_0^smax (1 - g(s)) s**chi ds, split at s = 1/2 so both halves are smooth.
+
+    [0, 1/2]: Gauss-Legendre in t = s**(chi+1), which absorbs the s**chi singularity;
+    [1/2, smax]: in theta with s = (1 - cos theta)/2, where 1 - g = 1 - (theta -
+    sin 2 theta / 2)/pi is smooth (in s it behaves as (1 - s)**1.5 at s = 1).
+    16 nodes each: 5e-8 relative error at worst over chi in [-0.95, 0], smax in (0, 1].
+    """
     a = chi + 1.0
-    tmax = smax**a
-    t = tmax[..., None] * _NODES
-    s = t ** (1.0 / a[..., None])
-    return tmax / a * np.sum(_WEIGHTS * (1.0 - jenkins_inphase(s)), axis=-1)
+    t_a = np.minimum(smax, 0.5) ** a
+    s = (t_a[..., None] * _NODES) ** (1.0 / a[..., None])
+    low = t_a / a * np.sum(_WEIGHTS * (1.0 - jenkins_inphase(s)), axis=-1)
+    th0 = 0.5 * np.pi
+    th1 = np.arccos(1.0 - 2.0 * np.maximum(smax, 0.5))
+    th = th0 + (th1 - th0)[..., None] * _NODES
+    s_b = 0.5 * (1.0 - np.cos(th))
+    one_minus_g = 1.0 - (th - 0.5 * np.sin(2.0 * th)) / np.pi
+    high = (th1 - th0) * np.sum(_WEIGHTS * one_minus_g * s_b ** chi[..., None] * 0.5 * np.sin(th), axis=-1)
+    return low + high
 
 
 def _J_broadcast(chi: NDArray, smax: NDArray) -> NDArray:
