@@ -5,16 +5,17 @@ From a run's envelopes (`jointcal.signal.envelopes`):
 * resonance where the relative displacement z is in quadrature with the base
   acceleration (z leads a_base by 90 deg, i.e. lags the effective force -m a_base by
   90 deg; interpolated crossing), corrected for the sweep's lag: a sweep at rate r
-  shows the steady-state phase delayed by the group delay tau_g = |d phi / d omega|,
-  so f_res = f_crossing - sgn(r) r tau_g, tau_g measured from the phase slope at the
-  crossing (first order in eta; method 'quadrature'). Beyond eta_frf the envelopes are
-  not quasi-steady and the whole-record FRF's quadrature is used (method 'frf').
+  shows the steady-state phase delayed by the group delay tau_g, so
+  f_res = f_crossing - sgn(r) r tau_g (first order in eta). For quasi-steady sweeps
+  (eta <= eta_max) tau_g = 1/(zeta omega), the phase relaxation time at fixed amplitude,
+  with the phase-resonance zeta (method 'quadrature'); beyond, tau_g = |d phi/d omega|
+  from the measured phase slope (method 'quadrature_slope'); beyond eta_frf the
+  whole-record FRF's quadrature (method 'frf').
 * the peak of the response envelope (the paper's resonance read-out);
 * damping by half-power bandwidth of the response envelope (the paper's estimate),
   and by phase-resonance energy balance at quadrature, zeta = |a_base| / (2 omega^2 q)
   (one amplitude, no bandwidth); force-driven: zeta = |F| / (2 m |a|).
-* group_delay_s: |d phi/d omega| of the quadrature phase at the crossing (s), the
-  slope used for the sweep-lag correction;
+* group_delay_s: the lag tau_g used for the correction (s);
 * quality flags; a flagged value is kept and marked, never dropped. 'unusable' marks a
   row the calibration must not use.
 """
@@ -138,8 +139,16 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
         local = np.abs(np.gradient(f, t_e)) if len(f) > 2 else np.array([rate_hz_per_s])
         rate = float(np.interp(t_x, t_e, local)) if np.all(np.isfinite(local)) else rate_hz_per_s
         rate = rate if 0 < rate < 10 * rate_hz_per_s else rate_hz_per_s
+        # Quasi-steady sweeps lag by the phase relaxation time at fixed amplitude,
+        # 1/(zeta omega); the slope seen along the sweep also holds the resonance moving
+        # with amplitude (a softening joint's backbone), which overstates the lag. Beyond
+        # eta_max the measured zeta is itself corrupted by the transient: use the slope.
+        if not force and np.isfinite(z_guess) and z_guess > 0 and rate / (f_x * z_guess) ** 2 <= eta_max:
+            tau_g = 1.0 / (2 * np.pi * f_x * z_guess)
+            method = "quadrature"
+        else:
+            method = "quadrature_slope"
         f_res = f_x - sgn * rate * tau_g
-        method = "quadrature"
     else:
         flags.append("no_quadrature")
         f_x, t_x = f_peak, np.nan
@@ -148,12 +157,12 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
         tau_g = np.nan
     omega = 2 * np.pi * f_res
     if force:
-        zeta_pr = a_ref / (2 * (mass_lbf / G) * a_resp * G) if method == "quadrature" else np.nan
+        zeta_pr = a_ref / (2 * (mass_lbf / G) * a_resp * G) if method.startswith("quadrature") else np.nan
     else:
-        zeta_pr = a_ref * G / (2 * omega**2 * q) if method == "quadrature" else np.nan
+        zeta_pr = a_ref * G / (2 * omega**2 * q) if method.startswith("quadrature") else np.nan
     zeta_eta = zeta_pr if np.isfinite(zeta_pr) else zeta_hp
     eta = rate_hz_per_s / (f_res * zeta_eta) ** 2 if np.isfinite(zeta_eta) else np.nan
-    if np.isfinite(eta) and eta > eta_frf and record is not None and method == "quadrature" and not force:
+    if np.isfinite(eta) and eta > eta_frf and record is not None and method.startswith("quadrature") and not force:
         f_frf = _frf_quadrature(record, row, f_x)
         if np.isfinite(f_frf):
             f_res, method = f_frf, "frf"
