@@ -298,3 +298,15 @@ def test_csv_writer_failing_midway_keeps_old_file(tmp_path, monkeypatch):
         write_csv_atomic(pd.DataFrame({"a": [1]}), target)
     assert target.read_text() == "old\n"
     assert _listing(tmp_path) == ["runs.csv"]
+
+
+def test_clipped_mask_marks_exactly_the_stuck_runs():
+    from jointcal._checks import clipped_mask, stuck_runs
+
+    x = np.sin(np.linspace(0, 20 * np.pi, 2000)) * 1.3
+    y = np.clip(x, -1.0, 1.1)  # asymmetric limits
+    mask = clipped_mask(y)
+    _, starts = stuck_runs(y, 3)
+    assert mask.any() and set(np.flatnonzero(np.diff(np.r_[0, mask.astype(int)]) == 1)) == set(starts)
+    assert np.all((y[mask] == 1.1) | (y[mask] == -1.0))
+    assert not clipped_mask(x).any()

@@ -18,7 +18,7 @@ from jointcal._contract import (
     OnDataProblem, excitation_of, fail,
 )
 
-__all__ = ["validate_run"]
+__all__ = ["validate_run", "clipped_mask"]
 
 
 def stuck_runs(x: NDArray[np.float64], min_len: int) -> tuple[float, NDArray[np.int64]]:
@@ -64,6 +64,37 @@ def stuck_runs(x: NDArray[np.float64], min_len: int) -> tuple[float, NDArray[np.
         return float("nan"), np.empty(0, dtype=np.int64)
     found.sort()
     return found[0][1], np.array([s for s, _ in found], dtype=np.int64)
+
+
+def clipped_mask(x: NDArray[np.float64], min_len: int = 3) -> NDArray[np.bool_]:
+    """Samples inside the clipped runs that `stuck_runs` finds (same definition).
+
+    Parameters
+    ----------
+    x : ndarray of float, shape (n,)
+        One channel.
+    min_len : int
+        Shortest run, in samples, that counts as clipping.
+
+    Returns
+    -------
+    ndarray of bool, shape (n,)
+        True for every sample of a run of >= `min_len` consecutive samples equal to the
+        channel's maximum or minimum.
+    """
+    mask = np.zeros(x.shape, dtype=bool)
+    finite = np.isfinite(x)
+    if not finite.any():
+        return mask
+    for value in (np.max(x[finite]), np.min(x[finite])):
+        if value == 0.0:
+            continue
+        at = np.concatenate(([0], (x == value).astype(np.int8), [0]))
+        edges = np.diff(at)
+        for s, e in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
+            if e - s >= min_len:
+                mask[s:e] = True
+    return mask
 
 
 def peak_frequency(x: NDArray[np.float64], fs: float, *, pad: int = 16) -> float:

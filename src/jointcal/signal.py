@@ -18,9 +18,10 @@ from numpy.typing import NDArray
 from scipy.signal import ShortTimeFFT, savgol_filter
 from scipy.signal.windows import hann
 
+from ._checks import clipped_mask
 from .models import G
 
-__all__ = ["EnvelopeMeta", "window_length", "track_drive", "envelopes"]
+__all__ = ["EnvelopeMeta", "window_length", "track_drive", "envelopes", "meta_dict"]
 
 
 @dataclass(frozen=True)
@@ -132,12 +133,8 @@ def envelopes(df: pd.DataFrame, row: dict, *, zeta_min: float = 0.01, hop_fracti
     kind = "force" if "force_lbf" in df.columns else "base"
     ref = df["force_lbf" if kind == "force" else "base_accel_g"].to_numpy(dtype=float)
     resp = df["response_accel_g"].to_numpy(dtype=float)
-    bad_sample = ~np.isfinite(ref) | ~np.isfinite(resp)
-    for x in (ref, resp):  # samples stuck at the extreme (clipping) are bad too
-        m = np.nanmax(np.abs(x)) if np.any(np.isfinite(x)) else 0.0
-        at = np.isfinite(x) & (np.abs(x) >= m * (1 - 1e-12)) & (m > 0)
-        run = at & (np.r_[False, at[:-1]] | np.r_[at[1:], False])
-        bad_sample |= run if run.sum() >= 3 else False
+    # NaN/inf and clipped samples (the ingest stage's definition) are left out
+    bad_sample = ~np.isfinite(ref) | ~np.isfinite(resp) | clipped_mask(ref) | clipped_mask(resp)
     ref = np.where(np.isfinite(ref), ref, 0.0)
     resp = np.where(np.isfinite(resp), resp, 0.0)
     ref = ref - np.median(ref)  # DC offsets do not enter the demodulation, but do the ridge
