@@ -143,7 +143,7 @@ def run(u, ud, H, Gsub, Wub, Phi, Gf, lz, lv, az, bzu, bzf, cy, dyu, dyf,
                     turn = True
                     zt = z0
                 if joint == 1:
-                    F, K, ns, d, ow, ou, oF = advance(su, sF, ns, d, z1, zt, turn, KT, R, chi, phimax, Fs)
+                    F, K, ns, d = advance(su, sF, ns, d, z1, zt, turn, KT, R, chi, phimax, Fs)
                 else:
                     F = 0.0
                     K = 0.0

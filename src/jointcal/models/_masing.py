@@ -66,41 +66,25 @@ def _segment(su, sF, n, d, z_to, KT, R, chi, phimax, Fs):
 def advance(su, sF, n, d, z_to, z_turn, has_turn, KT, R, chi, phimax, Fs):
     """Advance the Iwan state to z_to, optionally through a reversal at z_turn.
 
-    Mutates the stack in place and returns ``(F, K_tan, n, d, ow, ow_u, ow_F)``;
-    ``ow >= 0`` is the stack slot overwritten by the pushed reversal, with its old
-    content, so that a tentative evaluation can be undone by `undo`.
-    The stack must have room for one push (``len(su) > n``).
+    Mutates the stack in place (it must have room for one push, ``len(su) > n``) and
+    returns ``(F, K_tan, n, d)``: force (lbf), tangent (lbf/in), stack depth, direction.
     """
-    ow = -1
-    ow_u = 0.0
-    ow_F = 0.0
     if has_turn:
         if d == 0:  # first motion ends in a reversal
             d = 1 if z_turn > 0.0 else -1
             Fz, K = backbone(z_turn, KT, R, chi, phimax, Fs)
         else:
             n, Fz, K = _segment(su, sF, n, d, z_turn, KT, R, chi, phimax, Fs)
-        ow = n
-        ow_u = su[n]
-        ow_F = sF[n]
         su[n] = z_turn
         sF[n] = Fz
         n += 1
         d = -d
     elif d == 0:
         if z_to == 0.0:
-            return 0.0, KT, n, d, ow, ow_u, ow_F
+            return 0.0, KT, n, d
         d = 1 if z_to > 0.0 else -1
     n, F, K = _segment(su, sF, n, d, z_to, KT, R, chi, phimax, Fs)
-    return F, K, n, d, ow, ow_u, ow_F
-
-
-@njit(cache=True, inline="always")
-def undo(su, sF, ow, ow_u, ow_F):
-    """Restore the stack slot a tentative `advance` overwrote."""
-    if ow >= 0:
-        su[ow] = ow_u
-        sF[ow] = ow_F
+    return F, K, n, d
 
 
 @njit(cache=True)
@@ -140,7 +124,7 @@ def force_history(u, KT, R, chi, phimax, Fs):
             F[i] = F[i - 1] if i > 0 else 0.0
             K[i] = K[i - 1] if i > 0 else KT
             continue
-        Fi, Ki, n, d, ow, ou, oF = advance(su, sF, n, d, z, z_prev, turn, KT, R, chi, phimax, Fs)
+        Fi, Ki, n, d = advance(su, sF, n, d, z, z_prev, turn, KT, R, chi, phimax, Fs)
         F[i] = Fi
         K[i] = Ki
         z_prev = z
