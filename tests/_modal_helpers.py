@@ -6,9 +6,8 @@ import numpy as np
 import pandas as pd
 
 from jointcal.io import read_manifest, read_run
-from jointcal.modal import modal_properties, scatter
+from jointcal.modal import measure_run, scatter
 from jointcal.models import harmonic_balance
-from jointcal.signal import envelopes
 
 
 def modal_table(folder, **kw):
@@ -16,8 +15,7 @@ def modal_table(folder, **kw):
     rows = []
     for row in man.to_dict("records"):
         df = read_run(Path(folder) / row["file"])
-        env, meta = envelopes(df, row)
-        rows.append(modal_properties(env, row, rate_hz_per_s=meta.rate_hz_per_s, record=df, **kw))
+        rows.append(measure_run(df, row, modal_kw=kw)[2])
     return pd.DataFrame(rows)
 
 

@@ -25,8 +25,9 @@ import numpy as np
 import pandas as pd
 
 from .models import G
+from .signal import envelopes
 
-__all__ = ["modal_properties", "scatter", "FLAG_WORDS"]
+__all__ = ["modal_properties", "measure_run", "scatter", "FLAG_WORDS"]
 
 FLAG_WORDS = {
     "eta_high": "sweep too fast for quasi-steady envelopes (eta > eta_max)",
@@ -212,6 +213,37 @@ def _frf_quadrature(record: pd.DataFrame, row: dict, f_guess: float) -> float:
     i = c[np.argmin(np.abs(fr[band][c] - f_guess))]
     w = (np.pi / 2 - ph[i]) / (ph[i + 1] - ph[i])
     return float(fr[band][i] + w * (fr[band][i + 1] - fr[band][i]))
+
+
+def measure_run(record: pd.DataFrame, row: dict, *, envelopes_kw: dict | None = None,
+                modal_kw: dict | None = None):
+    """One run from its record to its modal properties: the one record -> envelopes -> modal chain.
+
+    The workflow's envelopes and modal stages, the validation stage (on simulated
+    records) and the tests all call this, so that measured and simulated responses go
+    through the same window, ridge and estimators.
+
+    Parameters
+    ----------
+    record : DataFrame
+        The run record (columns of the raw-data contract).
+    row : mapping
+        Its manifest row.
+    envelopes_kw, modal_kw : dict, optional
+        Keyword options of `jointcal.signal.envelopes` and `modal_properties` (the
+        config's ``envelopes`` and ``modal`` sections).
+
+    Returns
+    -------
+    env : DataFrame
+        The envelopes (see `jointcal.signal.envelopes`).
+    meta : EnvelopeMeta
+    props : dict
+        One row of modal_properties.csv.
+    """
+    env, meta = envelopes(record, row, **(envelopes_kw or {}))
+    props = modal_properties(env, row, rate_hz_per_s=meta.rate_hz_per_s, record=record, **(modal_kw or {}))
+    return env, meta, props
 
 
 def scatter(table: pd.DataFrame) -> pd.DataFrame:
