@@ -9,7 +9,7 @@
 # Everything:      snakemake --cores 2      (a bare `snakemake` uses profiles/default/)
 # One stage:       snakemake --cores 2 ingest
 # Other campaign:  snakemake --cores 2 --config raw_data=PATH/TO/CAMPAIGN results=PATH
-from snakemake.utils import min_version, validate
+from snakemake.utils import min_version
 
 min_version("8.0")
 
@@ -17,10 +17,7 @@ min_version("8.0")
 configfile: "workflow/config/config.yaml"
 
 
-validate(config, "workflow/schemas/config.schema.yaml")
-
-
-include: "workflow/rules/common.smk"
+include: "workflow/rules/common.smk"  # checks and validates the config first
 include: "workflow/rules/ingest.smk"
 include: "workflow/rules/envelopes.smk"
 include: "workflow/rules/modal.smk"

@@ -3,8 +3,6 @@
 # those before a rerun, and an interrupted GA resumes from its checkpoint).
 import re
 
-import jointcal
-
 CALIBRATION = RESULTS / "calibration"
 ASSEMBLY_RE = "|".join(re.escape(a) for a in ASSEMBLIES) or "no-assembly"
 
@@ -18,7 +16,7 @@ rule calibrate_assembly:
         logbook=CALIBRATION / "{assembly}" / "ga_logbook.csv",
         curves=CALIBRATION / "{assembly}" / "model_curves.csv",
     params:
-        version=jointcal.__version__,  # src/ edits do not rerun rules: a version bump does
+        code=source_hash("calibrate.py"),
         calibrate=config.get("calibrate", {}),
         checkpoint=lambda wc: str(RESULTS / "checkpoints" / "calibration" / f"{wc.assembly}.pkl"),
     wildcard_constraints:
@@ -42,7 +40,7 @@ rule calibration_figures:
                            caption="../report/ga_convergence.rst", category="Calibration",
                            subcategory="{assembly}"),
     params:
-        version=jointcal.__version__,
+        code=source_hash("calibration_figures.py"),
     wildcard_constraints:
         assembly=ASSEMBLY_RE,
     threads: 1

@@ -3,6 +3,29 @@ import csv
 import sys
 from pathlib import Path
 
+from snakemake.utils import validate
+
+from jointcal._workflow import config_problem, stage_hash
+
+# Config: an unknown key (a typo) is one line naming the nearest valid key, before the schema's own
+# validation (whose message is a dump of the schema); nested --config values given as text are converted.
+SCHEMA = Path(workflow.current_basedir).parent / "schemas" / "config.schema.yaml"
+if problem := config_problem(config, SCHEMA):
+    sys.exit(f"jointcal: {problem}")
+validate(config, SCHEMA)
+
+SCRIPTS = Path(workflow.current_basedir).parent / "scripts"
+
+
+def source_hash(script):
+    """Content hash of a stage script and every jointcal module it imports (jointcal._workflow.stage_hash).
+
+    Passed as a rule's params, so a change to the code a stage runs reruns that stage and its
+    descendants (Snakemake's params trigger); a package version nobody bumps would not.
+    """
+    return stage_hash(SCRIPTS / script)
+
+
 RAW_DATA = Path(config["raw_data"])
 RESULTS = Path(config["results"])
 MANIFEST = RAW_DATA / "manifest.csv"

@@ -1,6 +1,4 @@
 # Stage envelopes: drive-frequency ridge and complex amplitudes per run (jointcal.signal).
-import jointcal
-
 
 rule envelopes_run:
     input:
@@ -10,7 +8,7 @@ rule envelopes_run:
         env=RESULTS / "envelopes" / "{run_id}.csv",
         meta=RESULTS / "envelopes" / "{run_id}.json",
     params:
-        version=jointcal.__version__,
+        code=source_hash("envelopes.py"),
         envelopes=config["envelopes"],
     log:
         RESULTS / "logs" / "envelopes" / "{run_id}.log",

@@ -1,6 +1,4 @@
 # Stage ingest: validate the raw-data campaign and tabulate its runs (jointcal.io).
-import jointcal
-
 
 rule ingest:
     input:
@@ -8,7 +6,7 @@ rule ingest:
     output:
         runs=RESULTS / "ingest" / "runs.csv",
     params:
-        version=jointcal.__version__,  # src/ edits do not rerun rules: a version bump does
+        code=source_hash("ingest.py"),
         ingest=config["ingest"],
     log:
         RESULTS / "logs" / "ingest.log",

@@ -1,6 +1,4 @@
 # Stage modal: resonance, damping and amplitude per run, scatter across repeats (jointcal.modal).
-import jointcal
-
 
 rule modal_properties:
     input:
@@ -12,7 +10,7 @@ rule modal_properties:
         table=RESULTS / "modal" / "modal_properties.csv",
         scatter=RESULTS / "modal" / "scatter.csv",
     params:
-        version=jointcal.__version__,
+        code=source_hash("modal.py"),
         modal=config["modal"],
     log:
         RESULTS / "logs" / "modal.log",
@@ -34,7 +32,7 @@ rule modal_figures:
         spectrogram=report(RESULTS / "figures" / "spectrogram_ridge.png",
                            caption="../report/spectrogram_ridge.rst", category="Modal properties"),
     params:
-        version=jointcal.__version__,
+        code=source_hash("modal_figures.py"),
         envelopes=config["envelopes"],
     log:
         RESULTS / "logs" / "modal_figures.log",

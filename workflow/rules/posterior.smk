@@ -2,8 +2,6 @@
 # Include after calibrate.smk (uses its ASSEMBLY_RE).
 # Chain checkpoints live in <results>/checkpoints/ (not declared outputs: an interrupted
 # chain resumes from its last chunk).
-import jointcal
-
 POSTERIOR = RESULTS / "posterior"
 
 
@@ -18,7 +16,7 @@ rule posterior_assembly:
         constraints=POSTERIOR / "{assembly}" / "constraints.txt",
         predictive=POSTERIOR / "{assembly}" / "predictive.csv",
     params:
-        version=jointcal.__version__,
+        code=source_hash("posterior.py"),
         calibrate=config.get("calibrate", {}),
         posterior=config.get("posterior", {}),
         checkpoint=lambda wc: str(RESULTS / "checkpoints" / "posterior" / f"{wc.assembly}.npz"),
@@ -38,7 +36,7 @@ rule posterior_corner:
         corner=report(RESULTS / "figures" / "corner_{assembly}.png", caption="../report/corner.rst",
                       category="Posterior", subcategory="{assembly}"),
     params:
-        version=jointcal.__version__,
+        code=source_hash("posterior_corner.py"),
     wildcard_constraints:
         assembly=ASSEMBLY_RE,
     threads: 1
@@ -62,7 +60,7 @@ rule posterior_report:
         markdown=report(POSTERIOR / "table_3_2.md", caption="../report/table_3_2.rst", category="Posterior"),
         qsma=POSTERIOR / "qsma_vs_harmonic_balance.csv",
     params:
-        version=jointcal.__version__,
+        code=source_hash("posterior_report.py"),
         calibrate=config.get("calibrate", {}),
         assemblies=ASSEMBLIES,
     threads: 1

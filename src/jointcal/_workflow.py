@@ -1,0 +1,197 @@
+"""Parse-time helpers of the Snakemake workflow: what a stage's code is, and config keys users mistype.
+
+`stage_sources` follows a stage script's ``jointcal`` imports through the package with
+`ast` (every ``import``/``from ... import`` statement, at any depth of the file, relative
+imports resolved, each parent package's ``__init__`` included as Python runs it), so a
+module added later is never forgotten; `stage_hash` is the SHA-256 of those files. The
+workflow passes the hash as a rule's ``params`` so that editing ``jointcal.modal`` reruns
+the modal rules and their descendants, and nothing upstream. Not seen: imports built at
+run time (``importlib``), third-party packages, and data files read by the package.
+
+`config_problem` checks a merged config against the workflow's JSON schema before
+Snakemake's own ``validate`` (whose message is a dump of the schema): an unknown key gets
+one line naming it and the nearest valid key, and a value the schema rejects one line naming
+the key and the reason; a value Snakemake's ``--config`` left as text
+in a nested section is converted to the schema's type when it parses as one.
+"""
+from __future__ import annotations
+
+import ast
+import difflib
+import hashlib
+import os
+from collections.abc import Mapping, MutableMapping
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+__all__ = ["stage_sources", "stage_hash", "config_problem"]
+
+_PACKAGE = "jointcal"
+_ROOT = Path(__file__).resolve().parent  # the jointcal package being imported
+
+
+def _module_file(name: str) -> Path | None:
+    """File of module `name` (``jointcal.a.b``) inside the package, or None."""
+    parts = name.split(".")[1:]
+    base = _ROOT.joinpath(*parts)
+    for f in (base / "__init__.py", base.with_suffix(".py")):
+        if f.is_file():
+            return f
+    return None
+
+
+def _module_name(f: Path) -> tuple[str, bool] | None:
+    """Dotted name of a file inside the package and whether it is a package ``__init__``."""
+    try:
+        rel = f.resolve().relative_to(_ROOT)
+    except ValueError:
+        return None
+    parts = [_PACKAGE, *rel.with_suffix("").parts]
+    if parts[-1] == "__init__":
+        return ".".join(parts[:-1]), True
+    return ".".join(parts), False
+
+
+def _imported(tree: ast.AST, here: tuple[str, bool] | None) -> set[str]:
+    """Dotted names a module's import statements may load (a ``from`` import's names may be modules)."""
+    names: set[str] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            names.update(a.name for a in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                if here is None:
+                    continue
+                pkg = here[0] if here[1] else here[0].rpartition(".")[0]
+                pkg = ".".join(pkg.split(".")[: len(pkg.split(".")) - (node.level - 1)])
+                base = f"{pkg}.{node.module}" if node.module else pkg
+            else:
+                base = node.module or ""
+            names.add(base)
+            names.update(f"{base}.{a.name}" for a in node.names)
+    return {n for n in names if n == _PACKAGE or n.startswith(_PACKAGE + ".")}
+
+
+def stage_sources(script: str | os.PathLike[str]) -> list[Path]:
+    """The script and every ``jointcal`` source file it imports, recursively.
+
+    Parameters
+    ----------
+    script : path-like
+        A workflow script (``workflow/scripts/<stage>.py``) or a module of the package.
+
+    Returns
+    -------
+    list of Path
+        The script first, then the package files in sorted order.
+    """
+    script = Path(script).resolve()
+    seen: set[Path] = set()
+    todo = [script]
+    while todo:
+        f = todo.pop()
+        if f in seen:
+            continue
+        seen.add(f)
+        for name in _imported(ast.parse(f.read_bytes(), filename=str(f)), _module_name(f)):
+            parts = name.split(".")
+            for i in range(1, len(parts) + 1):  # importing a.b.c runs a/__init__ and a/b/__init__ first
+                dep = _module_file(".".join(parts[:i]))
+                if dep is not None and dep not in seen:
+                    todo.append(dep)
+    return [script, *sorted(seen - {script})]
+
+
+def stage_hash(script: str | os.PathLike[str]) -> str:
+    """SHA-256 (hex, first 16 digits) of `stage_sources` (paths inside the package and contents)."""
+    h = hashlib.sha256()
+    for f in stage_sources(script):
+        rel = f.relative_to(_ROOT).as_posix() if f.is_relative_to(_ROOT) else f.name
+        h.update(rel.encode() + b"\0" + f.read_bytes() + b"\0")
+    return h.hexdigest()[:16]
+
+
+def _resolve(schema: Mapping[str, Any], root: Mapping[str, Any]) -> Mapping[str, Any]:
+    ref = schema.get("$ref")
+    if isinstance(ref, str) and ref.startswith("#/"):
+        node: Any = root
+        for part in ref[2:].split("/"):
+            node = node[part]
+        return {**node, **{k: v for k, v in schema.items() if k != "$ref"}}
+    return schema
+
+
+_TYPES = {"number": (int, float), "integer": (int,), "boolean": (bool,), "array": (list,), "object": (dict,)}
+
+
+def _coerce(value: Any, schema: Mapping[str, Any]) -> Any:
+    """A text value (as ``--config`` leaves nested ones) parsed to the schema's type, if it parses as one."""
+    want = schema.get("type")
+    if isinstance(value, str) and want in _TYPES:
+        try:
+            parsed = yaml.safe_load(value)
+        except yaml.YAMLError:
+            return value
+        ok = isinstance(parsed, _TYPES[want]) and not (want != "boolean" and isinstance(parsed, bool))
+        return parsed if ok else value
+    return value
+
+
+def config_problem(config: MutableMapping[str, Any], schema_file: str | os.PathLike[str]) -> str | None:
+    """Check config keys against the schema, recursively; convert nested text values in place.
+
+    Parameters
+    ----------
+    config : dict
+        Snakemake's merged config (edited in place: text values of nested sections that
+        parse as the schema's number, integer, boolean or array become that).
+    schema_file : path-like
+        The workflow's JSON schema (YAML).
+
+    Returns
+    -------
+    str or None
+        One sentence naming the first unknown key and the nearest valid one, or else
+        the first value the schema rejects, or None.
+    """
+    root = yaml.safe_load(Path(schema_file).read_text())
+
+    def walk(cfg: MutableMapping[str, Any], schema: Mapping[str, Any], path: str) -> str | None:
+        props = schema.get("properties", {})
+        for key in list(cfg):
+            where = f"{path}{key}"
+            if key not in props:
+                if schema.get("additionalProperties", True) is not False:
+                    continue
+                near = difflib.get_close_matches(str(key), list(props), n=1, cutoff=0.5)
+                hint = (f"did you mean '{path}{near[0]}'?" if near else
+                        f"the keys here are {', '.join(props)}.")
+                return (f"config key '{where}' is not a setting of this workflow; {hint} "
+                        f"(all settings: workflow/config/config.yaml)")
+            sub = _resolve(props[key], root)
+            cfg[key] = value = _coerce(cfg[key], sub)
+            if isinstance(value, list) and isinstance(sub.get("items"), Mapping):
+                cfg[key] = [_coerce(v, _resolve(sub["items"], root)) for v in value]
+            if isinstance(value, MutableMapping) and "properties" in sub:
+                found = walk(value, sub, f"{where}.")
+                if found:
+                    return found
+        return None
+
+    found = walk(config, root, "")
+    if found:
+        return found
+    from jsonschema import Draft202012Validator  # Snakemake's own validator (a dependency of snakemake)
+    from jsonschema.exceptions import best_match
+
+    err = best_match(Draft202012Validator(root).iter_errors(config))
+    if err is None:
+        return None
+    where = ".".join(map(str, err.absolute_path)) or "(top level)"
+    msg = f"config '{where}': {err.message}"
+    if err.validator == "type" and isinstance(err.instance, str):
+        msg += ("; a nested section given with --config is read as text: put it in a YAML file and pass "
+                "--configfile my.yaml")
+    return msg + " (all settings: workflow/config/config.yaml)"
