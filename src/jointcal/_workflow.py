@@ -130,9 +130,9 @@ def _coerce(value: Any, schema: Mapping[str, Any]) -> Any:
     """A text value (as ``--config`` leaves nested ones) parsed to the schema's type, if it parses as one."""
     want = schema.get("type")
     if isinstance(value, str) and want in _TYPES:
-        try:
-            parsed = yaml.safe_load(value)
-        except yaml.YAMLError:
+        try:  # float() reads 1e-3, which YAML 1.1 (PyYAML) leaves as text
+            parsed = int(value) if want == "integer" else float(value) if want == "number" else yaml.safe_load(value)
+        except (ValueError, yaml.YAMLError):
             return value
         ok = isinstance(parsed, _TYPES[want]) and not (want != "boolean" and isinstance(parsed, bool))
         return parsed if ok else value

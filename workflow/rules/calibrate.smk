@@ -22,6 +22,8 @@ rule calibrate_assembly:
     wildcard_constraints:
         assembly=ASSEMBLY_RE,
     threads: 1
+    benchmark:
+        RESULTS / "benchmarks" / "calibrate" / "{assembly}.tsv"
     log:
         RESULTS / "logs" / "calibrate" / "{assembly}.log",
     script:
@@ -44,6 +46,8 @@ rule calibration_figures:
     wildcard_constraints:
         assembly=ASSEMBLY_RE,
     threads: 1
+    benchmark:
+        RESULTS / "benchmarks" / "calibration_figures" / "{assembly}.tsv"
     log:
         RESULTS / "logs" / "calibration_figures" / "{assembly}.log",
     script:

@@ -1,5 +1,6 @@
 # Shared paths and input functions of the jointcal workflow (logic lives in src/jointcal/).
 import csv
+import os
 import sys
 from pathlib import Path
 
@@ -57,3 +58,27 @@ ASSEMBLIES = list(dict.fromkeys(r["assembly"] for r in _manifest_rows() if r.get
 def run_record(wildcards):
     """The raw record of one run."""
     return RUN_FILES[wildcards.run_id]
+
+
+def remove_stale_outputs():
+    """After a failed run, remove the outputs of every job the run had scheduled and did not finish.
+
+    Snakemake deletes the outputs of the job that failed; those of the previous run further down
+    (calibration, posterior, figures, table) would stay and look current. A job scheduled to rerun
+    has outdated outputs (its inputs, code hash or params changed, or an upstream job reran), so
+    they go; finished jobs, logs, benchmarks and the GA/chain checkpoints stay (a rerun resumes).
+    """
+    dag = workflow.dag
+    if dag is None:
+        return
+    stale = [Path(f) for job in dag.needrun_jobs(exclude_finished=True) for f in job.output if os.path.isfile(f)]
+    for f in stale:
+        f.unlink(missing_ok=True)
+    if stale:
+        shown = ", ".join(str(f) for f in stale[:4]) + (f" and {len(stale) - 4} more" if len(stale) > 4 else "")
+        print(f"jointcal: the run failed; removed {len(stale)} outputs of jobs that did not run to the end, "
+              f"so nothing out of date looks current: {shown}", file=sys.stderr)
+
+
+onerror:
+    remove_stale_outputs()

@@ -10,6 +10,8 @@ rule envelopes_run:
     params:
         code=source_hash("envelopes.py"),
         envelopes=config["envelopes"],
+    benchmark:
+        RESULTS / "benchmarks" / "envelopes" / "{run_id}.tsv"
     log:
         RESULTS / "logs" / "envelopes" / "{run_id}.log",
     script:

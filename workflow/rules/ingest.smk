@@ -8,6 +8,8 @@ rule ingest:
     params:
         code=source_hash("ingest.py"),
         ingest=config["ingest"],
+    benchmark:
+        RESULTS / "benchmarks" / "ingest.tsv"
     log:
         RESULTS / "logs" / "ingest.log",
     script:

@@ -12,6 +12,8 @@ rule modal_properties:
     params:
         code=source_hash("modal.py"),
         modal=config["modal"],
+    benchmark:
+        RESULTS / "benchmarks" / "modal_properties.tsv"
     log:
         RESULTS / "logs" / "modal.log",
     script:
@@ -34,6 +36,8 @@ rule modal_figures:
     params:
         code=source_hash("modal_figures.py"),
         envelopes=config["envelopes"],
+    benchmark:
+        RESULTS / "benchmarks" / "modal_figures.tsv"
     log:
         RESULTS / "logs" / "modal_figures.log",
     script:

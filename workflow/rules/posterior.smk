@@ -23,6 +23,8 @@ rule posterior_assembly:
     wildcard_constraints:
         assembly=ASSEMBLY_RE,
     threads: 1
+    benchmark:
+        RESULTS / "benchmarks" / "posterior" / "{assembly}.tsv"
     log:
         RESULTS / "logs" / "posterior" / "{assembly}.log",
     script:
@@ -40,6 +42,8 @@ rule posterior_corner:
     wildcard_constraints:
         assembly=ASSEMBLY_RE,
     threads: 1
+    benchmark:
+        RESULTS / "benchmarks" / "posterior_corner" / "{assembly}.tsv"
     log:
         RESULTS / "logs" / "posterior_corner" / "{assembly}.log",
     script:
@@ -64,6 +68,8 @@ rule posterior_report:
         calibrate=config.get("calibrate", {}),
         assemblies=ASSEMBLIES,
     threads: 1
+    benchmark:
+        RESULTS / "benchmarks" / "posterior_report.tsv"
     log:
         RESULTS / "logs" / "posterior_report.log",
     script:

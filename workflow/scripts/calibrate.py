@@ -13,14 +13,20 @@ from jointcal.calibrate import CalibrateSettings, CalibrationInputError, run_cal
 
 def main(smk) -> None:
     log = Path(smk.log[0])
+    log_file = open(log, "w", buffering=1)  # line-buffered: GA/chain progress can be read while the job runs
+
+    def progress(line: str) -> None:
+        log_file.write(f"jointcal: {line}\n")
+
     try:
         settings = CalibrateSettings.from_config(smk.params.calibrate)
         _, notes = run_calibration(smk.input.modal, smk.wildcards.assembly, Path(smk.output.best).parent, settings,
-                                   checkpoint=smk.params.checkpoint)
+                                   checkpoint=smk.params.checkpoint, progress=progress)
     except (CalibrationInputError, ValueError) as exc:
-        log.write_text(f"jointcal: {exc}\n")
+        progress(str(exc))
         sys.exit(f"jointcal: {exc}")
-    log.write_text("".join(f"jointcal: {n}\n" for n in notes))
+    for n in notes:
+        progress(n)
 
 
 main(snakemake)  # noqa: F821 (provided by Snakemake)

@@ -14,18 +14,25 @@ from jointcal.posterior import PosteriorSettings, run_posterior
 
 def main(smk) -> None:
     log = Path(smk.log[0])
+    log_file = open(log, "w", buffering=1)  # line-buffered: GA/chain progress can be read while the job runs
+
+    def progress(line: str) -> None:
+        log_file.write(f"jointcal: {line}\n")
+
     try:
         cal = CalibrateSettings.from_config(smk.params.calibrate)
         post = PosteriorSettings.from_config(smk.params.posterior)
         res, notes = run_posterior(smk.input.modal, smk.input.scatter, smk.input.best, smk.wildcards.assembly,
-                                   Path(smk.output.summary).parent, cal, post, checkpoint=smk.params.checkpoint)
+                                   Path(smk.output.summary).parent, cal, post, checkpoint=smk.params.checkpoint,
+                                   progress=progress)
     except (CalibrationInputError, ValueError) as exc:
-        log.write_text(f"jointcal: {exc}\n")
+        progress(str(exc))
         sys.exit(f"jointcal: {exc}")
     for n in notes:
         if "floor" in n or "NOT converged" in n:
             print(f"jointcal: warning: {n}", file=sys.stderr)
-    log.write_text("".join(f"jointcal: {n}\n" for n in notes))
+    for n in notes:
+        progress(n)
 
 
 main(snakemake)  # noqa: F821 (provided by Snakemake)

@@ -17,6 +17,7 @@ import hashlib
 import json
 import os
 import pickle
+from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
 
@@ -42,8 +43,8 @@ def fingerprint(data: ModalData, s: CalibrateSettings) -> str:
 
 
 def run_calibration(modal_csv: str | os.PathLike[str], assembly: str, out_dir: str | os.PathLike[str],
-                    settings: CalibrateSettings, *, checkpoint: str | os.PathLike[str] | None = None
-                    ) -> tuple[Calibration, list[str]]:
+                    settings: CalibrateSettings, *, checkpoint: str | os.PathLike[str] | None = None,
+                    progress: Callable[[str], None] | None = None) -> tuple[Calibration, list[str]]:
     """Calibrate one assembly from ``modal_properties.csv`` and write the stage's outputs.
 
     Parameters
@@ -57,6 +58,9 @@ def run_calibration(modal_csv: str | os.PathLike[str], assembly: str, out_dir: s
     settings : CalibrateSettings
     checkpoint : path-like, optional
         GA checkpoint file: resumed from when it matches, rewritten as the GA runs.
+    progress : callable, optional
+        Receives one line (generation, best objective, stall count) every
+        ``checkpoint_every`` generations, for the stage's log.
 
     Returns
     -------
@@ -87,9 +91,14 @@ def run_calibration(modal_csv: str | os.PathLike[str], assembly: str, out_dir: s
             notes.append(f"{ckpt}: checkpoint made with other data or settings; starting afresh")
 
     def save(state: dict) -> None:
-        write_bytes_atomic(pickle.dumps({"fingerprint": fp, "ga": state}, protocol=4), ckpt)  # type: ignore[arg-type]
+        if ckpt is not None:
+            write_bytes_atomic(pickle.dumps({"fingerprint": fp, "ga": state}, protocol=4), ckpt)
+        if progress is not None:
+            progress(f"GA generation {state['generation']}/{settings.ga.generations}: best objective "
+                     f"{state['hof'][0].fitness.values[0]:.6g}, {state['stall']} generations without improvement"
+                     + (f"; checkpoint {ckpt}" if ckpt is not None else ""))
 
-    cal = calibrate(data, settings, resume=resume, on_checkpoint=None if ckpt is None else save)
+    cal = calibrate(data, settings, resume=resume, on_checkpoint=None if ckpt is None and progress is None else save)
     out = Path(out_dir)
     write_json_atomic(cal.best, out / "ga_best.json")
     write_csv_atomic(cal.history, out / "ga_history.csv")

@@ -22,6 +22,7 @@ import hashlib
 import io
 import json
 import os
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -64,7 +65,8 @@ def _npz(arrays: dict) -> bytes:
 def run_posterior(modal_csv: str | os.PathLike[str], scatter_csv: str | os.PathLike[str],
                   ga_best_json: str | os.PathLike[str], assembly: str, out_dir: str | os.PathLike[str],
                   cal: CalibrateSettings, ps: PosteriorSettings, *,
-                  checkpoint: str | os.PathLike[str] | None = None) -> tuple[ChainResult, list[str]]:
+                  checkpoint: str | os.PathLike[str] | None = None,
+                  progress: Callable[[str], None] | None = None) -> tuple[ChainResult, list[str]]:
     """Sample one assembly's posterior and write the stage's outputs.
 
     Parameters
@@ -79,6 +81,9 @@ def run_posterior(modal_csv: str | os.PathLike[str], scatter_csv: str | os.PathL
     cal, ps : CalibrateSettings, PosteriorSettings
     checkpoint : path-like, optional
         ``.npz`` checkpoint: resumed from when it matches, rewritten after every chunk.
+    progress : callable, optional
+        Receives one line (steps so far, largest running autocorrelation time, chain
+        length in units of it) after every chunk, for the stage's log.
 
     Returns
     -------
@@ -128,11 +133,18 @@ def run_posterior(modal_csv: str | os.PathLike[str], scatter_csv: str | os.PathL
                     **random_state_arrays(random_state))
 
     def save(state: dict) -> None:
-        write_bytes_atomic(_npz(arrays(**state)), ckpt)  # type: ignore[arg-type]
+        if ckpt is not None:
+            write_bytes_atomic(_npz(arrays(**state)), ckpt)
+        if progress is not None:
+            n, *tau = state["tau_history"][-1]
+            tmax = float(np.max(tau))
+            progress(f"posterior step {int(n)}/{ps.max_steps}: largest autocorrelation time {tmax:.0f} steps, "
+                     f"chain {n / tmax:.1f} tau (stops at {ps.tau_factor:g} tau)"
+                     + (f"; checkpoint {ckpt}" if ckpt is not None else ""))
 
     res = run_chain(lp, y0, seed=ps.seed, max_steps=ps.max_steps, chunk=ps.chunk, tau_factor=ps.tau_factor,
                     tau_rtol=ps.tau_rtol, observe=lambda c: lp.to_x(c)[..., [0, 1, 3, 4]], resume=resume,
-                    on_chunk=None if ckpt is None else save)
+                    on_chunk=None if ckpt is None and progress is None else save)
     chain_x = lp.to_x(res.chain)
     burn = burn_in(res.tau, res.steps, ps.burn_tau)
     summary = summarize(chain_x, lp.lower, lp.upper, burn=burn, ratio=ps.constrained_ratio)

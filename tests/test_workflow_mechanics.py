@@ -1,0 +1,199 @@
+"""How the workflow behaves around the science: reruns that follow the code, config messages,
+progress in the logs, no stale outputs after a failure, and the slurm profile.
+
+The Snakemake tests run on a copy of the repository's Snakefile, workflow/ and src/jointcal
+(so a module can be edited) with the small committed campaign, and mark the workflow's
+outputs as made with ``--touch`` instead of computing them: what is checked is which jobs
+Snakemake schedules, not what they compute (test_workflow.py runs them for real).
+"""
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from _campaign import REPO
+from _modal_tables import TABLE_3_2, write_tables
+
+from jointcal._workflow import config_problem, stage_sources
+from jointcal.calibrate import CalibrateSettings, run_calibration
+from jointcal.posterior import PosteriorSettings, run_posterior
+
+SCRIPTS = REPO / "workflow" / "scripts"
+SCHEMA = REPO / "workflow" / "schemas" / "config.schema.yaml"
+RULES = {"ingest", "envelopes_run", "modal_properties", "modal_figures", "calibrate_assembly", "calibration_figures",
+         "posterior_assembly", "posterior_corner", "posterior_report"}
+DOWNSTREAM_OF_MODAL = {"modal_properties", "modal_figures", "calibrate_assembly", "calibration_figures",
+                       "posterior_assembly", "posterior_corner", "posterior_report"}
+
+
+def _names(files: list[Path]) -> set[str]:
+    return {f.relative_to(REPO / "src" / "jointcal").as_posix() for f in files[1:]}
+
+
+def test_stage_sources_follow_imports_through_the_package():
+    modal = _names(stage_sources(SCRIPTS / "modal.py"))
+    assert {"modal.py", "signal.py", "io.py", "_checks.py", "__init__.py"} <= modal
+    assert not any(n.startswith(("calibrate/", "posterior/", "report/")) for n in modal)
+    assert "modal.py" not in _names(stage_sources(SCRIPTS / "ingest.py"))
+    # `from ..calibrate.space import ...` in report/calibration.py, and the packages' __init__ files
+    figures = _names(stage_sources(SCRIPTS / "calibration_figures.py"))
+    assert {"report/__init__.py", "report/calibration.py", "calibrate/__init__.py", "calibrate/space.py"} <= figures
+
+
+def test_typo_in_a_nested_key_names_the_nearest_valid_key():
+    config = {"raw_data": "raw_data", "calibrate": {"bounds": {"Fs": [1, 10]}, "populaton": 40}}
+    msg = config_problem(config, SCHEMA)
+    assert msg is not None and "\n" not in msg
+    assert "'calibrate.populaton'" in msg and "did you mean 'calibrate.population'?" in msg
+    assert "did you mean 'resul" in config_problem({"resuls": "out"}, SCHEMA)
+
+
+def test_nested_config_given_as_text_is_converted_or_named_in_one_line():
+    config = {"posterior": {"ball": "0.005", "rel_std_floor": {"frequency": "1e-3"}},  # as --config leaves them
+              "calibrate": {"bounds": {"Fs": ["1", "100"]}, "model": "qsma"}}
+    assert config_problem(config, SCHEMA) is None
+    assert config["posterior"]["ball"] == 0.005 and config["posterior"]["rel_std_floor"]["frequency"] == 1e-3
+    assert config["calibrate"]["bounds"]["Fs"] == [1, 100] and config["calibrate"]["model"] == "qsma"
+    msg = config_problem({"posterior": {"ball": "small"}}, SCHEMA)
+    assert msg.startswith("config 'posterior.ball': 'small' is not of type 'number'")
+    assert "--configfile my.yaml" in msg and "\n" not in msg
+
+
+def test_ga_generation_and_chain_tau_reach_the_log_while_running(tmp_path):
+    modal_csv, scatter_csv = write_tables(tmp_path, {"a": TABLE_3_2["first"]}, seed=3)
+    lines: list[str] = []
+    cal = CalibrateSettings.from_config({"population": 20, "offspring": 20, "generations": 4, "checkpoint_every": 2,
+                                         "stall_generations": 10, "n_polish": 0})
+    run_calibration(modal_csv, "a", tmp_path / "cal", cal, progress=lines.append)
+    assert [ln.split(":")[0] for ln in lines] == ["GA generation 2/4", "GA generation 4/4", "GA generation 4/4"]
+    assert "best objective" in lines[0]
+    lines.clear()
+    post = PosteriorSettings.from_config({"n_walkers": 16, "max_steps": 200, "chunk": 100})
+    run_posterior(modal_csv, scatter_csv, tmp_path / "cal" / "ga_best.json", "a", tmp_path / "post", cal, post,
+                  checkpoint=tmp_path / "chain.npz", progress=lines.append)
+    assert [ln.split(":")[0] for ln in lines] == ["posterior step 100/200", "posterior step 200/200"]
+    assert re.search(r"largest autocorrelation time \d+ steps, chain [\d.]+ tau \(stops at 50 tau\); checkpoint ",
+                     lines[-1]), lines[-1]
+
+
+# ------------------------------------------------------------------ Snakemake runs (slow)
+
+def _snakemake(work: Path, *args: str) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "PYTHONPATH": str(work / "src")}
+    return subprocess.run([sys.executable, "-m", "snakemake", *args], cwd=work, capture_output=True, text=True,
+                          env=env, timeout=300)
+
+
+def _jobs(res: subprocess.CompletedProcess[str]) -> dict[str, int]:
+    """Rule -> job count from a dry run's "Job stats" table (empty when nothing is to be done)."""
+    out = res.stdout + res.stderr
+    assert res.returncode == 0, out
+    m = re.search(r"Job stats:\njob\s+count\n-+\s+-+\n(.*?)\ntotal", out, re.S)
+    return {} if m is None else {k: int(v) for k, v in (ln.split() for ln in m.group(1).splitlines())}
+
+
+@pytest.fixture
+def touched(tmp_path: Path, small_campaign: Path) -> tuple[Path, list[str]]:
+    """A copy of the workflow and package whose outputs are all marked made (``--touch -F``)."""
+    work = tmp_path / "wf"
+    work.mkdir()
+    shutil.copy(REPO / "Snakefile", work)
+    ignore = shutil.ignore_patterns("__pycache__")
+    for folder in ("workflow", "profiles"):
+        shutil.copytree(REPO / folder, work / folder, ignore=ignore, symlinks=True)
+    shutil.copytree(REPO / "src" / "jointcal", work / "src" / "jointcal", ignore=ignore)
+    cfg = ["--config", f"raw_data={small_campaign}", f"results={work / 'results'}"]
+    summary = _snakemake(work, "--summary", *cfg)
+    assert summary.returncode == 0, summary.stderr
+    for line in summary.stdout.splitlines()[1:]:
+        out = Path(line.split("\t")[0])
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.touch()
+    res = _snakemake(work, "--cores", "1", "--touch", "--forceall", *cfg)
+    assert res.returncode == 0, res.stderr
+    assert _jobs(_snakemake(work, "-n", *cfg)) == {}
+    return work, cfg
+
+
+def _edit(path: Path) -> str:
+    """Append a comment to a module (a change to its text, not to what it does); return the original."""
+    text = path.read_text()
+    path.write_text(text + "\n# edited by test_workflow_mechanics\n")
+    return text
+
+
+@pytest.mark.slow
+def test_editing_a_stage_module_reruns_that_stage_and_its_descendants_only(touched):
+    work, cfg = touched
+    pkg = work / "src" / "jointcal"
+    cases = [
+        ("modal.py", DOWNSTREAM_OF_MODAL),  # not ingest, not envelopes
+        ("report/calibration.py", {"calibration_figures", "posterior_corner", "posterior_report"}),  # figures only
+        ("posterior/sampler.py", {"posterior_assembly", "posterior_corner", "posterior_report"}),  # not calibrate
+        ("io.py", RULES),  # every stage reads or writes through jointcal.io
+    ]
+    for module, expected in cases:
+        original = _edit(pkg / module)
+        jobs = _jobs(_snakemake(work, "-n", *cfg))
+        assert set(jobs) - {"all"} == expected, module
+        (pkg / module).write_text(original)
+    assert _jobs(_snakemake(work, "-n", *cfg)) == {}  # the hash is of the content: undoing an edit undoes the rerun
+
+
+@pytest.mark.slow
+def test_failed_rerun_removes_the_downstream_outputs_it_could_not_remake(touched):
+    work, cfg = touched
+    results = work / "results"
+    upstream = sorted(p for p in (results / "envelopes").iterdir()) + [results / "ingest" / "runs.csv"]
+    downstream = [results / "calibration" / "first" / "ga_best.json", results / "posterior" / "first" / "summary.csv",
+                  results / "posterior" / "table_3_2.csv", results / "figures" / "fig3_8_amplitude_fit.png",
+                  results / "figures" / "fig3_5_envelopes.png"]
+    assert all(p.is_file() for p in upstream + downstream)
+    modal = work / "src" / "jointcal" / "modal.py"
+    modal.write_text(modal.read_text() + "\nraise RuntimeError('a bug in the new modal code')\n")
+    res = _snakemake(work, "--cores", "1", *cfg)
+    assert res.returncode != 0
+    assert "a bug in the new modal code" in res.stderr
+    assert "so nothing out of date looks current" in res.stderr
+    assert not any(p.exists() for p in downstream), [p for p in downstream if p.exists()]
+    assert not (results / "modal" / "modal_properties.csv").exists()  # the failed job's own (Snakemake's doing)
+    assert all(p.is_file() for p in upstream)  # up to date: kept
+    assert (results / "logs" / "modal.log").is_file()
+
+
+@pytest.mark.slow
+def test_typo_in_config_is_one_line_before_any_schema_dump(touched):
+    work, cfg = touched
+    res = _snakemake(work, "-n", *cfg, "calibrate={populaton: 40}")
+    assert res.returncode != 0
+    assert res.stderr.strip().splitlines()[-1] == (
+        "jointcal: config key 'calibrate.populaton' is not a setting of this workflow; did you mean "
+        "'calibrate.population'? (all settings: workflow/config/config.yaml)")
+    assert "Failed validating" not in res.stderr and "Traceback" not in res.stderr
+    assert _jobs(_snakemake(work, "-n", *cfg, "posterior={ball: 0.002}")) == {
+        "posterior_assembly": 1, "posterior_corner": 1, "posterior_report": 1, "all": 1}  # params changed
+
+
+@pytest.mark.slow
+def test_slurm_profile_dry_run_has_one_job_per_run_and_per_assembly(tmp_path):
+    """On the example campaign (24 runs, 2 assemblies), with the profile's per-rule resources."""
+    work = tmp_path / "wf"
+    work.mkdir()
+    shutil.copy(REPO / "Snakefile", work)
+    shutil.copytree(REPO / "workflow", work / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copytree(REPO / "src" / "jointcal", work / "src" / "jointcal", ignore=shutil.ignore_patterns("__pycache__"))
+    res = _snakemake(work, "-n", "--workflow-profile", "workflow/profiles/slurm",
+                     "--config", f"raw_data={REPO / 'raw_data'}", f"results={tmp_path / 'results'}")
+    assert "workflow/profiles/slurm" in res.stderr + res.stdout
+    assert _jobs(res) == {"ingest": 1, "envelopes_run": 24, "modal_properties": 1, "modal_figures": 1,
+                          "calibrate_assembly": 2, "calibration_figures": 2, "posterior_assembly": 2,
+                          "posterior_corner": 2, "posterior_report": 1, "all": 1}
+    blocks = re.findall(r"rule (\w+):\n(?:    .*\n)*?    resources: (.*)", res.stdout + res.stderr)
+    resources = {rule: dict(kv.split("=", 1) for kv in line.split(", ")) for rule, line in blocks}
+    assert resources["calibrate_assembly"]["runtime"] == "60" and resources["posterior_assembly"]["runtime"] == "120"
+    assert resources["envelopes_run"]["runtime"] == "5" and resources["ingest"]["cpus_per_task"] == "1"
