@@ -90,12 +90,15 @@ def run_calibration(modal_csv: str | os.PathLike[str], assembly: str, out_dir: s
         elif saved:
             notes.append(f"{ckpt}: checkpoint made with other data or settings; starting afresh")
 
+    reported: list[int] = []
+
     def save(state: dict) -> None:
         if ckpt is not None:
             write_bytes_atomic(pickle.dumps({"fingerprint": fp, "ga": state}, protocol=4), ckpt)
-        if progress is not None:
+        if progress is not None and state["generation"] not in reported:  # (the last one comes twice)
+            reported.append(state["generation"])
             progress(f"GA generation {state['generation']}/{settings.ga.generations}: best objective "
-                     f"{state['hof'][0].fitness.values[0]:.6g}, {state['stall']} generations without improvement"
+                     f"{state['hof'][0].fitness.values[0]:.6g}, generations without improvement: {state['stall']}"
                      + (f"; checkpoint {ckpt}" if ckpt is not None else ""))
 
     cal = calibrate(data, settings, resume=resume, on_checkpoint=None if ckpt is None and progress is None else save)
