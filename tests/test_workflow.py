@@ -41,7 +41,8 @@ def test_ingest_rule_tabulates_every_run(workdir, tmp_path, small_campaign):
 
 def test_bare_run_uses_default_profile(workdir, tmp_path, small_campaign):
     out = tmp_path / "results"
-    res = _snakemake(workdir, "--config", f"raw_data={small_campaign}", f"results={out}")  # no --cores
+    # no --cores; one stage only (the whole workflow with the default GA and chain takes minutes)
+    res = _snakemake(workdir, "ingest", "--config", f"raw_data={small_campaign}", f"results={out}")
     assert res.returncode == 0, res.stderr
     assert "profiles/default" in res.stderr + res.stdout
     assert (out / "ingest" / "runs.csv").is_file()
