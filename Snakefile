@@ -9,6 +9,10 @@
 # Everything:      snakemake --cores 2      (a bare `snakemake` uses profiles/default/)
 # One stage:       snakemake --cores 2 ingest
 # Other campaign:  snakemake --cores 2 --config raw_data=PATH/TO/CAMPAIGN results=PATH
+# Nested settings: snakemake --cores 2 --configfile my.yaml   (merged over workflow/config/config.yaml)
+# After a kill:    snakemake --unlock; snakemake --cores 2 --rerun-incomplete   (GA and chain resume)
+# On SLURM:        snakemake --workflow-profile workflow/profiles/slurm   (pip install -e ".[slurm]")
+# Report:          snakemake --report results/report.html
 from snakemake.utils import min_version
 
 min_version("8.0")
