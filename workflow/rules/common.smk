@@ -68,10 +68,13 @@ def remove_stale_outputs():
     has outdated outputs (its inputs, code hash or params changed, or an upstream job reran), so
     they go; finished jobs, logs, benchmarks and the GA/chain checkpoints stay (a rerun resumes).
     """
-    dag = workflow.dag
-    if dag is None:
+    try:  # Snakemake 9's DAG (workflow.dag, DAG.needrun_jobs)
+        jobs = list(workflow.dag.needrun_jobs(exclude_finished=True))
+    except AttributeError:
+        print("jointcal: the run failed; outputs of jobs that did not run may be out of date "
+              "(this Snakemake version does not show which)", file=sys.stderr)
         return
-    stale = [Path(f) for job in dag.needrun_jobs(exclude_finished=True) for f in job.output if os.path.isfile(f)]
+    stale = [Path(f) for job in jobs for f in job.output if os.path.isfile(f)]
     for f in stale:
         f.unlink(missing_ok=True)
     if stale:
