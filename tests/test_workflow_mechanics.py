@@ -44,6 +44,24 @@ def test_stage_sources_follow_imports_through_the_package():
     assert {"report/__init__.py", "report/calibration.py", "calibrate/__init__.py", "calibrate/space.py"} <= figures
 
 
+def test_every_script_rule_carries_its_code_hash_a_benchmark_and_slurm_threads():
+    """A stage added later gets the same treatment (checked on the rule files' text)."""
+    import yaml
+
+    profile = yaml.safe_load((REPO / "workflow" / "profiles" / "slurm" / "config.yaml").read_text())
+    rules = {}
+    for smk in sorted((REPO / "workflow" / "rules").glob("*.smk")):
+        for block in re.split(r"(?m)^(?=rule )", smk.read_text())[1:]:
+            rules[block.split(":")[0].removeprefix("rule ")] = block
+    scripted = {name: b for name, b in rules.items() if "script:" in b}
+    assert len(scripted) >= 9
+    for name, block in scripted.items():
+        script = re.search(r'script:\s*"\.\./scripts/(\w+\.py)"', block).group(1)
+        assert f'code=source_hash("{script}")' in block, name
+        assert "benchmark:" in block and "__version__" not in block, name
+        assert name in profile["set-threads"], name
+
+
 def test_typo_in_a_nested_key_names_the_nearest_valid_key():
     config = {"raw_data": "raw_data", "calibrate": {"bounds": {"Fs": [1, 10]}, "populaton": 40}}
     msg = config_problem(config, SCHEMA)
