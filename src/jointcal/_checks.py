@@ -21,11 +21,13 @@ from jointcal._contract import (
 __all__ = ["validate_run", "clipped_mask", "clip_levels", "UNUSABLE_FLAGS"]
 
 LEVEL_RTOL = 0.10  # reference amplitude vs the manifest's level: 10x a controller's normal 1 % ripple
+UNIT_RTOL = 0.015  # a ratio this close to a unit factor is named as a units mistake (example: within 0.2 %)
 SWAP_PEAK = 2.0  # a controlled reference never peaks at twice its median amplitude over the sweep
 UNIT_FACTORS = {  # excitation -> {unit a record or level may wrongly be in: its size in the contract's unit}
     "base": {"m/s^2": 9.80665, "in/s^2": 386.089, "ft/s^2": 32.174},
     "force": {"N": 4.44822},
 }
+TIME_UNITS = {"milliseconds": 1e-3, "microseconds": 1e-6, "minutes": 60.0}  # unit -> its size in s
 # ingest flags whose run must not enter a calibration (its amplitudes or channels are wrong)
 UNUSABLE_FLAGS = ("level", "swapped", "constant")
 
@@ -220,9 +222,9 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
 
     The reference's median amplitude over 20-cycle windows of the sweep must be the
     manifest's level within ``LEVEL_RTOL`` (10 %: ten times a controller's normal
-    ripple; the example campaign is within 0.2 %); a ratio near a unit factor
-    (9.80665 for m/s^2, 386.089 for in/s^2, 4.44822 for N) is named as a units
-    mistake. A reference peaking at more than ``SWAP_PEAK`` times its median while
+    ripple; the example campaign is within 0.2 %); a ratio within ``UNIT_RTOL``
+    (1.5 %) of a unit factor (9.80665 for m/s^2, 386.089 for in/s^2, 4.44822 for N)
+    is named as a units mistake, any other as a wrong level or sensitivity. A reference peaking at more than ``SWAP_PEAK`` times its median while
     the response stays flatter than half that is taken for swapped columns.
     """
     if on_data_problem not in ("error", "flag"):
@@ -262,7 +264,8 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
     if not silent:
         _report(_amplitude_problems(chans, kind, row, fs, sweep_s, path, run), flags, on_data_problem)
     rms = {f"rms_{c}": float("nan") for c in (*REFERENCE.values(), RESPONSE)}
-    rms.update({f"rms_{c}": float(np.sqrt(np.mean(x[np.isfinite(x)] ** 2))) for c, x in chans.items()})
+    rms.update({f"rms_{c}": float(np.sqrt(np.mean(x[np.isfinite(x)] ** 2))) for c, x in chans.items()
+                if np.isfinite(x).any()})
     return {"n_samples": t.size, "duration_s": t.size / fs, "fs_measured_hz": fs, "excitation": kind, **rms,
             "f_first_hz": f_first, "f_last_hz": f_last, "f_tolerance_hz": tol, "flags": flags}
 
@@ -285,6 +288,11 @@ def _check_time(t: NDArray[np.float64], fs: float, path: object, run: str) -> fl
         fail(path, f"time_s jumps by {dt[i]:.3g} s after {t[i]:.9g} s (the usual step is {step:.3g} s)",
              "export an evenly sampled record without gaps")
     fs_meas = (t.size - 1) / (t[-1] - t[0])
+    units = {**TIME_UNITS, "sample numbers": 1.0 / fs}  # a time column in another unit, guessed and named
+    for unit, seconds in units.items():
+        if abs(fs_meas / fs - 1) > FS_RTOL and abs(fs_meas / (seconds * fs) - 1) <= 0.01:
+            fail(path, f"time_s advances by {step:.6g} per sample, which at sample_rate_hz = {fs:g} Hz means it is "
+                 f"written in {unit}", f"export time_s in seconds (multiply by {seconds:.6g})")
     if abs(fs_meas / fs - 1) > FS_RTOL:
         fail(path, f"the measured sample rate {fs_meas:.6g} Hz differs from sample_rate_hz = {fs:g} Hz "
              f"by {abs(fs_meas / fs - 1):.2%}", f"correct sample_rate_hz for run {run} in manifest.csv")
@@ -377,7 +385,7 @@ def _amplitude_problems(chans: dict[str, NDArray[np.float64]], kind: str, row: M
     if flat[ref] > SWAP_PEAK and flat[RESPONSE] < flat[ref] / 2:
         return [(f"swapped:{ref}",
                  f"{path}: column '{ref}' peaks at {flat[ref]:.3g} times its median amplitude while "
-                 f"'{RESPONSE}' stays within {flat[RESPONSE]:.3g} times (the controlled reference is flat, the "
+                 f"'{RESPONSE}' stays within {flat[RESPONSE]:.2f} times (the controlled reference is flat, the "
                  f"response peaks at resonance), so the two columns look swapped; export each channel under "
                  f"its own name {drop}.")]
     level, unit = float(row[LEVEL[kind]]), LEVEL[kind].split("_", 1)[1]
@@ -388,11 +396,11 @@ def _amplitude_problems(chans: dict[str, NDArray[np.float64]], kind: str, row: M
     what = "base" if kind == "base" else kind
     said = f"{what} amplitude is {got:.3g} {unit} where the manifest says {LEVEL[kind]} = {level:g} {unit} for run {run}"
     for other, factor in UNIT_FACTORS[kind].items():
-        if abs(ratio / factor - 1) <= LEVEL_RTOL:
-            return [(f"level:{ref}", f"{path}: {said} (x{factor:g}): is the record in {other}?; export "
+        if abs(ratio / factor - 1) <= UNIT_RTOL:
+            return [(f"level:{ref}", f"{path}: {said} (x{ratio:.4g}): is the record in {other}?; export "
                      f"{ref} and {RESPONSE} in {unit} (divide by {factor:g}) {drop}.")]
-        if abs(ratio * factor - 1) <= LEVEL_RTOL:
-            return [(f"level:{ref}", f"{path}: {said} (x1/{factor:g}): is {LEVEL[kind]} written in {other}?; "
+        if abs(ratio * factor - 1) <= UNIT_RTOL:
+            return [(f"level:{ref}", f"{path}: {said} (x1/{1 / ratio:.4g}): is {LEVEL[kind]} written in {other}?; "
                      f"write {LEVEL[kind]} of run {run} in {unit} in manifest.csv {drop}.")]
     return [(f"level:{ref}", f"{path}: {said} (x{ratio:.3g}, more than {LEVEL_RTOL:.0%} off): the manifest's level "
              f"or the channel's sensitivity is wrong; correct {LEVEL[kind]} of run {run} in manifest.csv or the "
