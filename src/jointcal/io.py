@@ -30,7 +30,7 @@ from jointcal._contract import (
 
 __all__ = [
     "CampaignError", "CampaignWarning", "read_manifest", "read_run", "validate_run",
-    "ingest_campaign", "write_bytes_atomic", "write_csv_atomic", "write_json_atomic",
+    "ingest_campaign", "listed_record", "write_bytes_atomic", "write_csv_atomic", "write_json_atomic",
     "write_run",
 ]
 
@@ -275,3 +275,25 @@ def ingest_campaign(campaign_dir: str | os.PathLike[str], *,
         checks["flags"] = ";".join(checks["flags"])
         rows.append({**row.to_dict(), **checks})
     return pd.DataFrame(rows)
+
+
+def listed_record(file: str | os.PathLike[str], paths: list[str] | tuple[str, ...]) -> str | None:
+    """The path among `paths` that is the manifest's run `file`, matched on its whole relative path.
+
+    Parameters
+    ----------
+    file : path-like
+        The manifest's ``file`` cell (relative to the campaign folder).
+    paths : sequence of str
+        Paths of the campaign's run files (the campaign folder joined with each ``file``).
+
+    Returns
+    -------
+    str or None
+        The shortest path ending with all of `file`'s parts (``a/run.csv`` is not
+        ``b/a/run.csv``); None if none does. Never matched on the basename alone:
+        two folders may hold files of one name.
+    """
+    parts = Path(file).parts
+    hits = [p for p in paths if Path(p).parts[-len(parts):] == parts]
+    return min(hits, key=lambda p: len(Path(p).parts)) if hits else None
