@@ -341,10 +341,11 @@ def test_workflow_keeps_the_nan_warning_when_an_error_follows(tmp_path, campaign
 
 @pytest.mark.slow
 def test_workflow_keeps_a_units_mistake_out_of_the_modal_fit(tmp_path, campaign):
-    """Flagged before calibration: a record in m/s^2 and a wrong level reach modal_properties.csv as
-    unusable (select_modal leaves them out); duplicate basenames keep their own records."""
+    """Flagged before calibration: a record in m/s^2 reaches modal_properties.csv as unusable
+    (select_modal leaves it out; a wrong level takes the same path, see the tests above);
+    duplicate basenames keep their own records."""
     edit_run(campaign, "run03.csv.gz", _si)
-    edit_manifest(campaign, lambda m: m.assign(level_g=m["level_g"].where(m["run_id"] != "run05", "10")))
+    edit_manifest(campaign, lambda m: m[m["run_id"].isin(["run01", "run02", "run03"])])  # 3 runs: CI time
     for rid, folder in (("run01", "a"), ("run02", "b")):
         (campaign / folder).mkdir()
         shutil.move(campaign / f"{rid}.csv.gz", campaign / folder / "run.csv.gz")
@@ -357,8 +358,7 @@ def test_workflow_keeps_a_units_mistake_out_of_the_modal_fit(tmp_path, campaign)
     assert "is the record in m/s^2?" in (out / "logs" / "ingest.log").read_text()
     modal = pd.read_csv(out / "modal" / "modal_properties.csv", keep_default_na=False).set_index("run_id")
     assert "unusable" in modal.loc["run03", "flags"] and "level:base_accel_g" in modal.loc["run03", "flags"]
-    assert "unusable" in modal.loc["run05", "flags"]
-    assert "unusable" not in ";".join(modal.loc[["run01", "run02", "run04"], "flags"])
-    assert select_modal(modal.reset_index(), "first").run_id == ("run01", "run02", "run04")
+    assert "unusable" not in ";".join(modal.loc[["run01", "run02"], "flags"])
+    assert select_modal(modal.reset_index(), "first").run_id == ("run01", "run02")
     # each of the two run.csv.gz files gave its own run's resonance (up and down sweeps agree to 1 %)
     assert abs(modal.loc["run01", "f_res_hz"] / modal.loc["run02", "f_res_hz"] - 1) < 0.01
