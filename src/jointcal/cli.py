@@ -65,7 +65,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("campaign_dir", metavar="CAMPAIGN_DIR", help="folder holding manifest.csv and the run files")
     p.add_argument("out_csv", metavar="OUT_CSV", help="table to write (one row per run)")
     p.add_argument("--on-data-problem", choices=("error", "flag"), default="error",
-                   help="NaN/inf values and clipping: fail (default) or record them in the flags column")
+                   help="data problems (NaN/inf, clipping, dead or swapped channels, amplitude off the level): "
+                        "fail (default) or record them in the flags column")
     p.set_defaults(func=_cmd_ingest)
 
     p = sub.add_parser("synth", help="generate a synthetic campaign (virtual shaker lab) from a truth spec",
