@@ -176,7 +176,7 @@ def test_level_mistakes_are_left_out_of_the_calibration():
                           "flags": ["", "level:base_accel_g", "swapped:base_accel_g;bad_samples",
                                     "clipped:response_accel_g"]})
     data = select_modal(modal, "first")
-    assert data.run_id == ("r1", "r4")  # clipping alone is informational: its samples are left out
+    assert data.run_id == ("r1",)  # clipped: the peak is missing, damping biased high (see below)
 
 
 # ------------------------------------------------------------------------ dead and swapped channels
@@ -362,3 +362,16 @@ def test_workflow_keeps_a_units_mistake_out_of_the_modal_fit(tmp_path, campaign)
     assert select_modal(modal.reset_index(), "first").run_id == ("run01", "run02")
     # each of the two run.csv.gz files gave its own run's resonance (up and down sweeps agree to 1 %)
     assert abs(modal.loc["run01", "f_res_hz"] / modal.loc["run02", "f_res_hz"] - 1) < 0.01
+
+
+def test_clipped_runs_stay_out_of_the_fit_because_leaving_frames_out_does_not_save_the_damping():
+    """Why `clipped` is in UNUSABLE_FLAGS: with the clipped frames left out, the resonance peak is
+    missing and the damping of a linear SDOF (zeta 0.02) clipped at 60 % of its peak comes out far high."""
+    from jointcal.modal import measure_run
+
+    t, base, resp, peak = _sdof_sweep(12800.0)
+    zeta = {}
+    for frac in (2.0, 0.6):
+        df = pd.DataFrame({"time_s": t, "base_accel_g": _adc(base, 4.0), "response_accel_g": _adc(resp, frac * peak)})
+        zeta[frac] = measure_run(df, _row(12800.0))[2]["zeta_phase_resonance"]
+    assert zeta[0.6] > 1.5 * zeta[2.0]  # measured: +90 % vs +13 % (the clean run's sweep-rate bias)

@@ -28,8 +28,10 @@ UNIT_FACTORS = {  # excitation -> {unit a record or level may wrongly be in: its
     "force": {"N": 4.44822},
 }
 TIME_UNITS = {"milliseconds": 1e-3, "microseconds": 1e-6, "minutes": 60.0}  # unit -> its size in s
-# ingest flags whose run must not enter a calibration (its amplitudes or channels are wrong)
-UNUSABLE_FLAGS = ("level", "swapped", "constant")
+# ingest flags whose run must not enter a calibration: its amplitudes or channels are wrong, or
+# it is clipped (a linear SDOF clipped at 95-60 % of its resonance peak gives damping 14-138 %
+# high even with the frames touching clipped samples left out: the peak itself is missing)
+UNUSABLE_FLAGS = ("level", "swapped", "constant", "clipped")
 
 
 def quantum(v: NDArray[np.float64]) -> float:

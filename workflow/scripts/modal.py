@@ -35,7 +35,7 @@ def main(smk) -> None:
             out["flags"] = ";".join(dict.fromkeys(ingest_flags + [f for f in out["flags"].split(";") if f]))
             out["window_s"] = meta["window_s"]
         wrong = [f for f in ingest_flags if f.split(":")[0] in UNUSABLE_FLAGS]
-        if wrong and "unusable" not in out["flags"].split(";"):  # wrong units, level or channels: not for a fit
+        if wrong and "unusable" not in out["flags"].split(";"):  # wrong units, level, channels; clipped: no fit
             out["flags"] = ";".join([*out["flags"].split(";"), "unusable"]).lstrip(";")
             notes.append(f"{rid}: unusable: ingest flagged {', '.join(wrong)} (see the ingest log); "
                          "left out of the calibration")

@@ -5,8 +5,8 @@ the damping column named in the config, ``flags``; ``level_g`` or ``level_lbf`` 
 carried along when present) and ``scatter.csv``
 (tidy repeatability: ``assembly, quantity, level_g, source, n, mean, std, rel_std``).
 Rows whose ``flags`` name ``unusable``, or an ingest flag of wrong units or level,
-swapped channels or a constant channel (`jointcal._checks.UNUSABLE_FLAGS`), are left
-out; other flags are informational.
+swapped channels, a constant channel or clipping (`jointcal._checks.UNUSABLE_FLAGS`),
+are left out; other flags are informational.
 The pooled relative scatter of the frequency and of the chosen damping estimator is the
 likelihood's noise floor; a missing, zero or tiny pooled value is replaced by a floor
 from the config, and the replacement is reported in `ModalData.notes`. Every problem
@@ -74,7 +74,7 @@ class ModalData:
 
 
 def _usable(flags: pd.Series) -> NDArray[np.bool_]:
-    """False for runs flagged unusable or with an ingest flag of wrong units, level or channels."""
+    """False for runs flagged unusable or with an ingest flag in UNUSABLE_FLAGS (units, level, channels, clipping)."""
     text = flags.map(lambda v: "" if pd.isna(v) else str(v))
     return ~text.map(lambda t: any("unusable" in tok.strip().lower()
                                    or tok.strip().split(":")[0] in UNUSABLE_FLAGS for tok in t.split(";"))
