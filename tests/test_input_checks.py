@@ -122,6 +122,16 @@ def test_clean_quantised_sweeps_are_not_clipped(bits):
         assert clip_levels(_adc(x, fsc, bits)) == []
 
 
+def test_noiseless_synthetic_references_are_not_clipped():
+    """A float chirp or tone at a rational frequency hits its crest exactly on many samples
+    (sin rounds to 1 within 1e-8 rad): no pile-up against the samples just below or mid-range."""
+    fs = 25600.0
+    t = np.arange(int(0.5 * fs)) / fs
+    for x in (17.79 * np.sin(2 * np.pi * (1600 * t + 0.5 * 1000 * t**2)),  # 5 samples exactly at the crest
+              np.sin(2 * np.pi * 1600 * t), np.sin(2 * np.pi * 1000 * t)):  # every value repeats
+        assert clip_levels(x) == [] and not clipped_mask(x).any()
+
+
 def test_committed_campaigns_raise_no_flag():
     """No false positive on the example campaign (24-bit, noise, ripple) or the small one."""
     for campaign in (REPO / "raw_data", REPO / "tests" / "data" / "small_campaign"):

@@ -79,31 +79,49 @@ def clip_levels(x: NDArray[np.float64], min_count: int = 3) -> list[tuple[float,
     within one quantisation step of) the same extreme value, whatever the length of
     each flat top (at 2.2 kHz sampled at 12.8 kHz, a clip at 95 % of the peak lasts
     one sample per half cycle). A noisy swept sine reaches its extreme once, and its
-    next-highest samples are spread below it. An extreme counts as clipped when at
-    least `min_count` samples sit within one step of it and they outnumber three
-    times the samples in the next two steps below it (the histogram's pile-up at
-    the extreme, which a sine's arcsine density never reaches). The step is the
-    smallest spacing of the distinct values near the extremes (the ADC's LSB for
-    quantised data; float rounding otherwise). A constant channel and an extreme
-    of exactly 0 (a silent channel) are not clipping.
+    next-highest samples are spread below it. An extreme counts as clipped when
+    `min_count` consecutive samples sit within one step of it (a flat top no sine
+    has), or when
+
+    * at least `min_count` samples sit within one step of it,
+    * they outnumber three times the samples in the band just below it, of width
+      ``max(3 steps, 1e-3 (extreme - median))`` (the histogram's pile-up at the
+      extreme: a noiseless synthetic chirp may hit its crest exactly on a few samples,
+      but far more of its samples then lie just below), and
+    * they outnumber twice the samples at the value nearest the median (a noiseless
+      tone at a rational frequency repeats every value, not only its extremes).
+
+    The step is the smallest spacing of the distinct values near the extremes (the
+    ADC's LSB for quantised data; float rounding otherwise). A constant channel and
+    an extreme of exactly 0 (a silent channel) are not clipping. Clipping at 60-99 %
+    of the peak is found in 24- and 16-bit records at 12.8 and 25.6 kHz; a 12-bit
+    record may hide a slight clip in its coarse steps.
     """
     if min_count < 2:
         raise ValueError(f"min_count must be >= 2, got {min_count}")
-    v = x[np.isfinite(x)]
+    finite = np.isfinite(x)
+    v = x[finite]
     if v.size < 2 or v.max() == v.min():
         return []
     step = quantum(v)
+    tol = 1.001 * step
+    centre = float(np.median(v))
     found = []
     for sign in (1.0, -1.0):
-        y = sign * x  # the maximum of y is the channel's maximum (sign 1) or minimum (sign -1)
-        top = float(np.nanmax(np.where(np.isfinite(y), y, -np.inf)))
+        y = sign * v  # the maximum of y is the channel's maximum (sign 1) or minimum (sign -1)
+        top, c = float(y.max()), sign * centre
         if top == 0.0:
             continue
-        at = y >= top - step * 1.001
-        below = (y >= top - 3.001 * step) & ~at
+        at = y >= top - tol
+        below = (y >= top - max(3.001 * step, 1e-3 * (top - c))) & ~at
+        mid = y[np.argmin(np.abs(y - c))]
         n_at, n_below = int(np.count_nonzero(at)), int(np.count_nonzero(below))
-        if n_at >= min_count and n_at > 3 * n_below:
-            found.append((sign * top, n_at, int(np.argmax(at))))
+        n_mid = int(np.count_nonzero(np.abs(y - mid) <= tol))
+        edges = np.diff(np.concatenate(([0], at.astype(np.int8), [0])))
+        longest = int((np.flatnonzero(edges == -1) - np.flatnonzero(edges == 1)).max())
+        if longest >= min_count or (n_at >= min_count and n_at > 3 * n_below and n_at > 2 * n_mid):
+            first = int(np.flatnonzero(finite)[np.argmax(at)])
+            found.append((sign * top, n_at, first))
     return found
 
 
@@ -226,8 +244,9 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
     manifest's level within ``LEVEL_RTOL`` (10 %: ten times a controller's normal
     ripple; the example campaign is within 0.2 %); a ratio within ``UNIT_RTOL``
     (1.5 %) of a unit factor (9.80665 for m/s^2, 386.089 for in/s^2, 4.44822 for N)
-    is named as a units mistake, any other as a wrong level or sensitivity. A reference peaking at more than ``SWAP_PEAK`` times its median while
-    the response stays flatter than half that is taken for swapped columns.
+    is named as a units mistake, any other as a wrong level or sensitivity. A
+    reference peaking at more than ``SWAP_PEAK`` times its median while the response
+    stays flatter than half that is taken for swapped columns.
     """
     if on_data_problem not in ("error", "flag"):
         raise ValueError(f"on_data_problem must be 'error' or 'flag', got {on_data_problem!r}")
@@ -396,11 +415,13 @@ def _amplitude_problems(chans: dict[str, NDArray[np.float64]], kind: str, row: M
     if abs(ratio - 1) <= LEVEL_RTOL:
         return []
     what = "base" if kind == "base" else kind
-    said = f"{what} amplitude is {got:.3g} {unit} where the manifest says {LEVEL[kind]} = {level:g} {unit} for run {run}"
+    said = (f"{what} amplitude is {got:.3g} {unit} where the manifest says {LEVEL[kind]} = {level:g} {unit} "
+            f"for run {run}")
     for other, factor in UNIT_FACTORS[kind].items():
         if abs(ratio / factor - 1) <= UNIT_RTOL:
+            chans_in = f"{ref} and {RESPONSE}" if kind == "base" else ref  # both accelerations share the unit
             return [(f"level:{ref}", f"{path}: {said} (x{ratio:.4g}): is the record in {other}?; export "
-                     f"{ref} and {RESPONSE} in {unit} (divide by {factor:g}) {drop}.")]
+                     f"{chans_in} in {unit} (divide by {factor:g}) {drop}.")]
         if abs(ratio * factor - 1) <= UNIT_RTOL:
             return [(f"level:{ref}", f"{path}: {said} (x1/{1 / ratio:.4g}): is {LEVEL[kind]} written in {other}?; "
                      f"write {LEVEL[kind]} of run {run} in {unit} in manifest.csv {drop}.")]
