@@ -13,7 +13,7 @@ import pytest
 import scipy.io
 from _campaign import DATA, edit_manifest, edit_run
 
-from jointcal._checks import peak_frequency, stuck_runs
+from jointcal._checks import clip_levels, peak_frequency
 from jointcal.io import (
     CampaignError, CampaignWarning, ingest_campaign, read_manifest, read_run, validate_run,
     write_bytes_atomic, write_csv_atomic, write_json_atomic, write_run,
@@ -105,12 +105,13 @@ def test_peak_frequency_of_a_tone():
     assert abs(peak_frequency(x, fs) - f) < 1.0
 
 
-def test_stuck_runs_finds_every_clipped_segment():
+def test_clip_levels_finds_both_limits():
     x = np.sin(np.linspace(0, 6 * np.pi, 600))
     x = np.clip(x, -0.9, 0.95)
-    value, starts = stuck_runs(x, 3)
-    assert starts.size == 6 and value == pytest.approx(0.95)
-    assert stuck_runs(np.sin(np.arange(1000.0)), 3)[1].size == 0
+    levels = clip_levels(x, 3)
+    assert [v for v, _, _ in levels] == [0.95, -0.9]
+    assert [n for _, n, _ in levels] == [np.count_nonzero(x == 0.95), np.count_nonzero(x == -0.9)]
+    assert clip_levels(np.sin(np.arange(1000.0)), 3) == []
 
 
 # ------------------------------------------------------------------------ malformed campaigns
@@ -153,7 +154,7 @@ RUN_CASES = {  # name: (file to edit, edit of its table, words the message must 
     "nan": ("run04.csv.gz", lambda d: _set(d, 500, "response_accel_g", np.nan), ["run04.csv.gz", "NaN"]),
     "inf": ("run04.csv.gz", lambda d: _set(d, 50, "base_accel_g", np.inf), ["run04.csv.gz", "NaN/inf"]),
     "clipped, many runs": ("run01.csv.gz", _clip, ["run01.csv.gz", "clipped"]),
-    "clipped, one run": ("run02.csv.gz", _stick, ["run02.csv.gz", "clipped (1 run of >= 3"]),
+    "clipped, one run": ("run02.csv.gz", _stick, ["run02.csv.gz", "clipped (3 samples at"]),
     "truncated": ("run03.csv.gz", lambda d: d.iloc[:5000], ["run03.csv.gz", "lasts"]),
 }
 MANIFEST_CASES = {  # name: (edit of the manifest, words the message must contain)
@@ -300,13 +301,11 @@ def test_csv_writer_failing_midway_keeps_old_file(tmp_path, monkeypatch):
     assert _listing(tmp_path) == ["runs.csv"]
 
 
-def test_clipped_mask_marks_exactly_the_stuck_runs():
-    from jointcal._checks import clipped_mask, stuck_runs
+def test_clipped_mask_marks_exactly_the_clipped_samples():
+    from jointcal._checks import clipped_mask
 
     x = np.sin(np.linspace(0, 20 * np.pi, 2000)) * 1.3
     y = np.clip(x, -1.0, 1.1)  # asymmetric limits
     mask = clipped_mask(y)
-    _, starts = stuck_runs(y, 3)
-    assert mask.any() and set(np.flatnonzero(np.diff(np.r_[0, mask.astype(int)]) == 1)) == set(starts)
-    assert np.all((y[mask] == 1.1) | (y[mask] == -1.0))
+    np.testing.assert_array_equal(mask, (y == 1.1) | (y == -1.0))
     assert not clipped_mask(x).any()

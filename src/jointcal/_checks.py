@@ -18,82 +18,137 @@ from jointcal._contract import (
     OnDataProblem, excitation_of, fail,
 )
 
-__all__ = ["validate_run", "clipped_mask"]
+__all__ = ["validate_run", "clipped_mask", "clip_levels", "UNUSABLE_FLAGS"]
+
+LEVEL_RTOL = 0.10  # reference amplitude vs the manifest's level: 10x a controller's normal 1 % ripple
+UNIT_RTOL = 0.015  # a ratio this close to a unit factor is named as a units mistake (example: within 0.2 %)
+SWAP_PEAK = 2.0  # a controlled reference never peaks at twice its median amplitude over the sweep
+UNIT_FACTORS = {  # excitation -> {unit a record or level may wrongly be in: its size in the contract's unit}
+    "base": {"m/s^2": 9.80665, "in/s^2": 386.089, "ft/s^2": 32.174},
+    "force": {"N": 4.44822},
+}
+TIME_UNITS = {"milliseconds": 1e-3, "microseconds": 1e-6, "minutes": 60.0}  # unit -> its size in s
+# ingest flags whose run must not enter a calibration: its amplitudes or channels are wrong, or
+# it is clipped (a linear SDOF clipped at 95-60 % of its resonance peak gives damping 14-138 %
+# high even with the frames touching clipped samples left out: the peak itself is missing)
+UNUSABLE_FLAGS = ("level", "swapped", "constant", "clipped")
 
 
-def stuck_runs(x: NDArray[np.float64], min_len: int) -> tuple[float, NDArray[np.int64]]:
-    """Find runs of samples stuck at the channel's extreme value (clipping).
+def quantum(v: NDArray[np.float64]) -> float:
+    """Quantisation step of a channel near its extremes (unit of `v`).
+
+    The smallest spacing between distinct values among the 4096 largest and the 4096
+    smallest finite samples of `v` (shape (n,)) strictly inside its range (a clipped
+    extreme holds one value): the ADC's LSB for quantised data. At most 1e-3 of the
+    range (a 10-bit ADC), at least 1e-12 of the largest magnitude (float rounding).
+    """
+    v = v[np.isfinite(v)]
+    if v.size < 2:
+        return 0.0
+    lo, hi = float(v.min()), float(v.max())
+    inner = v[(v > lo) & (v < hi)]
+    step = 1e-3 * (hi - lo)
+    if inner.size >= 2:
+        k = min(inner.size, 4096)
+        tails = np.unique(np.concatenate((np.partition(inner, inner.size - k)[inner.size - k:],
+                                          np.partition(inner, k - 1)[:k], [lo, hi])))
+        step = min(step, float(np.diff(tails).min()))
+    return max(step, 1e-12 * max(abs(lo), abs(hi)))
+
+
+def clip_levels(x: NDArray[np.float64], min_count: int = 3) -> list[tuple[float, int, int]]:
+    """Find the extreme values at which a channel is clipped, from its amplitude distribution.
 
     Parameters
     ----------
     x : ndarray of float, shape (n,)
-        One channel (any unit). Non-finite samples never belong to a run.
-    min_len : int
-        Shortest run, in samples, that counts as clipping (>= 2).
+        One channel (any unit). Non-finite samples are ignored.
+    min_count : int
+        Fewest samples at one extreme that count as clipping (>= 2).
 
     Returns
     -------
-    value : float
-        The clipped value of the first run found (same unit as `x`); NaN if none.
-    starts : ndarray of int, shape (k,)
-        Start index of every run of >= `min_len` consecutive samples equal to the
-        channel's maximum or to its minimum; empty when the channel is clean.
+    list of (value, count, first)
+        For the maximum and the minimum separately: the clipped value (unit of `x`),
+        the number of samples within one quantisation step of it, and the index of
+        the first; empty when the channel is clean.
 
     Notes
     -----
-    The maximum and the minimum are tested separately, so asymmetric clipping
-    (different positive and negative limits) and several clipped segments are found.
-    A swept sine sampled at > 2 points per cycle essentially never repeats its
-    extreme value exactly on consecutive samples, so exact equality is the test.
+    A clipped channel piles up at its full scale: many samples sit exactly at (or
+    within one quantisation step of) the same extreme value, whatever the length of
+    each flat top (at 2.2 kHz sampled at 12.8 kHz, a clip at 95 % of the peak lasts
+    one sample per half cycle). A noisy swept sine reaches its extreme once, and its
+    next-highest samples are spread below it. An extreme counts as clipped when
+    `min_count` consecutive samples sit within one step of it (a flat top no sine
+    has), or when
+
+    * at least `min_count` samples sit within one step of it,
+    * they outnumber three times the samples in the band just below it, of width
+      ``max(3 steps, 1e-3 (extreme - median))`` (the histogram's pile-up at the
+      extreme: a noiseless synthetic chirp may hit its crest exactly on a few samples,
+      but far more of its samples then lie just below), and
+    * they outnumber twice the samples at the value nearest the median (a noiseless
+      tone at a rational frequency repeats every value, not only its extremes).
+
+    The step is the smallest spacing of the distinct values near the extremes (the
+    ADC's LSB for quantised data; float rounding otherwise). A constant channel and
+    an extreme of exactly 0 (a silent channel) are not clipping. Clipping at 60-99 %
+    of the peak is found in 24- and 16-bit records at 12.8 and 25.6 kHz; a 12-bit
+    record may hide a slight clip in its coarse steps.
     """
-    if min_len < 2:
-        raise ValueError(f"min_len must be >= 2, got {min_len}")
+    if min_count < 2:
+        raise ValueError(f"min_count must be >= 2, got {min_count}")
     finite = np.isfinite(x)
-    if not finite.any():
-        return float("nan"), np.empty(0, dtype=np.int64)
-    found: list[tuple[int, float]] = []
-    for value in (np.max(x[finite]), np.min(x[finite])):
-        if value == 0.0:  # a silent channel is not clipped
+    v = x[finite]
+    if v.size < 2 or v.max() == v.min():
+        return []
+    step = quantum(v)
+    tol = 1.001 * step
+    centre = float(np.median(v))
+    found = []
+    for sign in (1.0, -1.0):
+        y = sign * v  # the maximum of y is the channel's maximum (sign 1) or minimum (sign -1)
+        top, c = float(y.max()), sign * centre
+        if top == 0.0:
             continue
-        at = np.concatenate(([0], (x == value).astype(np.int8), [0]))
-        edges = np.diff(at)
-        starts = np.flatnonzero(edges == 1)
-        stops = np.flatnonzero(edges == -1)
-        found += [(int(s), float(value)) for s in starts[stops - starts >= min_len]]
-    if not found:
-        return float("nan"), np.empty(0, dtype=np.int64)
-    found.sort()
-    return found[0][1], np.array([s for s, _ in found], dtype=np.int64)
+        at = y >= top - tol
+        below = (y >= top - max(3.001 * step, 1e-3 * (top - c))) & ~at
+        mid = y[np.argmin(np.abs(y - c))]
+        n_at, n_below = int(np.count_nonzero(at)), int(np.count_nonzero(below))
+        n_mid = int(np.count_nonzero(np.abs(y - mid) <= tol))
+        edges = np.diff(np.concatenate(([0], at.astype(np.int8), [0])))
+        longest = int((np.flatnonzero(edges == -1) - np.flatnonzero(edges == 1)).max())
+        if longest >= min_count or (n_at >= min_count and n_at > 3 * n_below and n_at > 2 * n_mid):
+            first = int(np.flatnonzero(finite)[np.argmax(at)])
+            found.append((sign * top, n_at, first))
+    return found
 
 
-def clipped_mask(x: NDArray[np.float64], min_len: int = 3) -> NDArray[np.bool_]:
-    """Samples inside the clipped runs that `stuck_runs` finds (same definition).
+def clipped_mask(x: NDArray[np.float64], min_count: int = 3) -> NDArray[np.bool_]:
+    """Samples at a clipped extreme that `clip_levels` finds (same definition).
 
     Parameters
     ----------
     x : ndarray of float, shape (n,)
         One channel.
-    min_len : int
-        Shortest run, in samples, that counts as clipping.
+    min_count : int
+        Fewest samples at one extreme that count as clipping.
 
     Returns
     -------
     ndarray of bool, shape (n,)
-        True for every sample of a run of >= `min_len` consecutive samples equal to the
-        channel's maximum or minimum.
+        True for every sample within one quantisation step of a clipped maximum or
+        minimum (the samples whose true value is unknown).
     """
     mask = np.zeros(x.shape, dtype=bool)
-    finite = np.isfinite(x)
-    if not finite.any():
+    levels = clip_levels(x, min_count)
+    if not levels:
         return mask
-    for value in (np.max(x[finite]), np.min(x[finite])):
-        if value == 0.0:
-            continue
-        at = np.concatenate(([0], (x == value).astype(np.int8), [0]))
-        edges = np.diff(at)
-        for s, e in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
-            if e - s >= min_len:
-                mask[s:e] = True
+    v = x[np.isfinite(x)]
+    step = quantum(v)
+    for value, _, _ in levels:
+        mask |= np.abs(x - value) <= step * 1.001
     return mask
 
 
@@ -146,11 +201,12 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
     path : path-like
         The record's file, named in messages.
     clip_run : int, optional
-        Shortest run of consecutive samples stuck at a channel's maximum or minimum
-        that counts as clipping (samples).
+        Fewest samples at a channel's maximum or minimum (within one quantisation
+        step) that count as clipping, flat tops of any length (see `clip_levels`).
     on_data_problem : {'error', 'flag'}, optional
-        What to do with data problems (NaN/inf values, clipping): raise, or record
-        them in ``flags`` and emit a `CampaignWarning` with the same sentence.
+        What to do with data problems (NaN/inf values, a constant channel, clipping,
+        swapped channels, a reference amplitude off the manifest's level): raise, or
+        record them in ``flags`` and emit a `CampaignWarning` with the same sentence.
         Structural problems always raise.
 
     Returns
@@ -163,8 +219,10 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
         a short window at the record's start and at the sweep's expected end time
         (which a free-decay tail may follow), each referred to that instant with the
         manifest's sweep rate (Hz); ``f_tolerance_hz``, the allowed deviation from
-        ``f_start_hz``/``f_stop_hz`` (Hz); ``flags``, a list such as
-        ``['nonfinite:response_accel_g', 'clipped:base_accel_g']``.
+        ``f_start_hz``/``f_stop_hz`` (Hz) (the three NaN when the reference holds no
+        signal); ``flags``, a list such as ``['nonfinite:response_accel_g',
+        'clipped:base_accel_g']``; the words are ``nonfinite``, ``constant``,
+        ``clipped``, ``swapped`` and ``level`` (see `UNUSABLE_FLAGS`).
 
     Raises
     ------
@@ -173,7 +231,7 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
         non-increasing or gapped time, sample rate off the manifest by > 0.1 %,
         a record shorter than 95 % of the sweep, a start or end drive frequency off
         the manifest band by more than ``f_tolerance_hz``; with
-        ``on_data_problem='error'`` also NaN/inf values and clipping.
+        ``on_data_problem='error'`` also the data problems.
 
     Notes
     -----
@@ -181,6 +239,14 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
     the lowest frequency; the sqrt balances sweep and resolution), at most a quarter
     of the sweep. The tolerance is ``rate * W / 2 + 1 / W``: the frequency swept
     within half the window plus one FFT bin.
+
+    The reference's median amplitude over 20-cycle windows of the sweep must be the
+    manifest's level within ``LEVEL_RTOL`` (10 %: ten times a controller's normal
+    ripple; the example campaign is within 0.2 %); a ratio within ``UNIT_RTOL``
+    (1.5 %) of a unit factor (9.80665 for m/s^2, 386.089 for in/s^2, 4.44822 for N)
+    is named as a units mistake, any other as a wrong level or sensitivity. A
+    reference peaking at more than ``SWAP_PEAK`` times its median while the response
+    stays flatter than half that is taken for swapped columns.
     """
     if on_data_problem not in ("error", "flag"):
         raise ValueError(f"on_data_problem must be 'error' or 'flag', got {on_data_problem!r}")
@@ -201,20 +267,26 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
              f"check f_start_hz, f_stop_hz and sweep_rate_hz_per_s of run {run} or export the whole record")
 
     flags: list[str] = []
-    for flag, msg in _data_problems(t, chans, clip_run, path, run):
-        if on_data_problem == "error":
-            raise CampaignError(msg)
-        warnings.warn(msg, CampaignWarning, stacklevel=2)
-        flags.append(flag)
-
-    f_first, f_last, tol = _drive_band(chans[REFERENCE[kind]], fs, f0, f1, rate)
+    problems = _data_problems(t, chans, clip_run, path, run)
+    _report(problems, flags, on_data_problem)
+    ref = REFERENCE[kind]
+    silent = {f.split(":", 1)[1] for f in flags if f.split(":", 1)[0] == "constant"}
+    silent |= {c for c, x in chans.items() if not np.isfinite(x).any()}
+    if ref in silent:  # no drive to measure: the flag says why, not a misleading band error
+        f_first = f_last = tol = float("nan")
+    else:
+        f_first, f_last, tol = _drive_band(chans[ref], fs, f0, f1, rate)
     for label, got, exp in (("start", f_first, f0), ("end", f_last, f1)):
         if abs(got - exp) > tol:
             fail(path, f"the drive frequency at the sweep {label} is {got:.0f} Hz, not {exp:g} Hz "
                  f"(+/- {tol:.0f} Hz) as the manifest band {band} says",
-                 f"correct direction, f_start_hz, f_stop_hz or sweep_rate_hz_per_s of run {run}")
+                 f"correct direction, f_start_hz, f_stop_hz or sweep_rate_hz_per_s of run {run}"
+                 + (f" (the record's data problems first: {', '.join(flags)})" if flags else ""))
+    if not silent:
+        _report(_amplitude_problems(chans, kind, row, fs, sweep_s, path, run), flags, on_data_problem)
     rms = {f"rms_{c}": float("nan") for c in (*REFERENCE.values(), RESPONSE)}
-    rms.update({f"rms_{c}": float(np.sqrt(np.mean(x[np.isfinite(x)] ** 2))) for c, x in chans.items()})
+    rms.update({f"rms_{c}": float(np.sqrt(np.mean(x[np.isfinite(x)] ** 2))) for c, x in chans.items()
+                if np.isfinite(x).any()})
     return {"n_samples": t.size, "duration_s": t.size / fs, "fs_measured_hz": fs, "excitation": kind, **rms,
             "f_first_hz": f_first, "f_last_hz": f_last, "f_tolerance_hz": tol, "flags": flags}
 
@@ -237,6 +309,11 @@ def _check_time(t: NDArray[np.float64], fs: float, path: object, run: str) -> fl
         fail(path, f"time_s jumps by {dt[i]:.3g} s after {t[i]:.9g} s (the usual step is {step:.3g} s)",
              "export an evenly sampled record without gaps")
     fs_meas = (t.size - 1) / (t[-1] - t[0])
+    units = {**TIME_UNITS, "sample numbers": 1.0 / fs}  # a time column in another unit, guessed and named
+    for unit, seconds in units.items():
+        if abs(fs_meas / fs - 1) > FS_RTOL and abs(fs_meas / (seconds * fs) - 1) <= 0.01:
+            fail(path, f"time_s advances by {step:.6g} per sample, which at sample_rate_hz = {fs:g} Hz means it is "
+                 f"written in {unit}", f"export time_s in seconds (multiply by {seconds:.6g})")
     if abs(fs_meas / fs - 1) > FS_RTOL:
         fail(path, f"the measured sample rate {fs_meas:.6g} Hz differs from sample_rate_hz = {fs:g} Hz "
              f"by {abs(fs_meas / fs - 1):.2%}", f"correct sample_rate_hz for run {run} in manifest.csv")
@@ -254,13 +331,103 @@ def _data_problems(t: NDArray[np.float64], chans: dict[str, NDArray[np.float64]]
             out.append((f"nonfinite:{name}",
                         f"{path}: column '{name}' has {_count(np.count_nonzero(bad), 'NaN/inf value')} (first at "
                         f"{t[np.argmax(bad)]:.6g} s); re-export the record without missing values {drop}."))
-        value, starts = stuck_runs(x, clip_run)
-        if starts.size:
+        finite = x[~bad]
+        if finite.size and finite.min() == finite.max():
+            out.append((f"constant:{name}",
+                        f"{path}: column '{name}' is constant at {finite[0]:.6g} (no signal recorded); check the "
+                        f"sensor, its cable and the channel's assignment and repeat the run {drop}."))
+            continue
+        levels = clip_levels(x, clip_run)
+        if levels:
+            where = " and ".join(f"{_count(n, 'sample')} at {v:.6g}" for v, n, _ in levels)
+            first = min(i for _, _, i in levels)
             out.append((f"clipped:{name}",
-                        f"{path}: column '{name}' is clipped ({_count(starts.size, 'run')} of >= {clip_run} samples "
-                        f"stuck at {value:.6g}, first at {t[starts[0]]:.6g} s); repeat the run with a wider input "
-                        f"range or a lower level {drop}."))
+                        f"{path}: column '{name}' is clipped ({where}, its full scale, first at {t[first]:.6g} s); "
+                        f"repeat the run with a wider input range or a lower level {drop}."))
     return out
+
+
+def _report(problems: list[tuple[str, str]], flags: list[str], on_data_problem: OnDataProblem) -> None:
+    """Raise the first data problem (``'error'``) or warn and append every flag (``'flag'``)."""
+    for flag, msg in problems:
+        if on_data_problem == "error":
+            raise CampaignError(msg)
+        warnings.warn(msg, CampaignWarning, stacklevel=3)
+        flags.append(flag)
+
+
+def window_amplitudes(x: NDArray[np.float64], fs: float, sweep_s: float, f_low: float) -> NDArray[np.float64]:
+    """Amplitude of a channel in consecutive windows over the sweep (unit of `x`).
+
+    Parameters
+    ----------
+    x : ndarray of float, shape (n,)
+        One channel, sampled at `fs` (Hz) from the sweep's start.
+    fs : float
+        Sample rate (Hz).
+    sweep_s : float
+        Duration of the sweep (s); a free-decay tail after it is left out.
+    f_low : float
+        Lowest drive frequency (Hz): each window spans ``MIN_CYCLES`` of its cycles.
+
+    Returns
+    -------
+    ndarray of float, shape (k,)
+        ``sqrt(2) * RMS`` of each mean-removed window (the amplitude of a sine), for
+        the windows with more than half their samples finite.
+    """
+    n = max(int(round(MIN_CYCLES / f_low * fs)), 8)
+    m = min(x.size, int(round(sweep_s * fs))) // n
+    w = x[: m * n].reshape(m, n)
+    ok = np.isfinite(w)
+    keep = ok.mean(axis=1) > 0.5
+    w, ok = w[keep], ok[keep]
+    mean = np.where(ok, w, 0.0).sum(axis=1, keepdims=True) / ok.sum(axis=1, keepdims=True)
+    return np.sqrt(2.0 * np.where(ok, (w - mean) ** 2, 0.0).sum(axis=1) / ok.sum(axis=1))
+
+
+def _amplitude_problems(chans: dict[str, NDArray[np.float64]], kind: str, row: Mapping[str, Any], fs: float,
+                        sweep_s: float, path: object, run: str) -> list[tuple[str, str]]:
+    """(flag, one-sentence message) for swapped channels or a reference amplitude off the manifest's level.
+
+    Only for a controlled reference (base acceleration or force): the controller holds
+    its amplitude at the level within a ripple, so the median window amplitude is the
+    level and the largest is barely above it, while the response peaks at resonance.
+    """
+    if kind not in UNIT_FACTORS or LEVEL[kind] not in row:
+        return []
+    ref = REFERENCE[kind]
+    drop = f"or remove run {run} from manifest.csv"
+    f_low = min(float(row["f_start_hz"]), float(row["f_stop_hz"]))
+    amp = {c: window_amplitudes(x, fs, sweep_s, f_low) for c, x in chans.items()}
+    if min(a.size for a in amp.values()) < 3:
+        return []
+    flat = {c: float(a.max() / np.median(a)) if np.median(a) > 0 else np.inf for c, a in amp.items()}
+    if flat[ref] > SWAP_PEAK and flat[RESPONSE] < flat[ref] / 2:
+        return [(f"swapped:{ref}",
+                 f"{path}: column '{ref}' peaks at {flat[ref]:.3g} times its median amplitude while "
+                 f"'{RESPONSE}' stays within {flat[RESPONSE]:.2f} times (the controlled reference is flat, the "
+                 f"response peaks at resonance), so the two columns look swapped; export each channel under "
+                 f"its own name {drop}.")]
+    level, unit = float(row[LEVEL[kind]]), LEVEL[kind].split("_", 1)[1]
+    got = float(np.median(amp[ref]))
+    ratio = got / level
+    if abs(ratio - 1) <= LEVEL_RTOL:
+        return []
+    what = "base" if kind == "base" else kind
+    said = (f"{what} amplitude is {got:.3g} {unit} where the manifest says {LEVEL[kind]} = {level:g} {unit} "
+            f"for run {run}")
+    for other, factor in UNIT_FACTORS[kind].items():
+        if abs(ratio / factor - 1) <= UNIT_RTOL:
+            chans_in = f"{ref} and {RESPONSE}" if kind == "base" else ref  # both accelerations share the unit
+            return [(f"level:{ref}", f"{path}: {said} (x{ratio:.4g}): is the record in {other}?; export "
+                     f"{chans_in} in {unit} (divide by {factor:g}) {drop}.")]
+        if abs(ratio * factor - 1) <= UNIT_RTOL:
+            return [(f"level:{ref}", f"{path}: {said} (x1/{1 / ratio:.4g}): is {LEVEL[kind]} written in {other}?; "
+                     f"write {LEVEL[kind]} of run {run} in {unit} in manifest.csv {drop}.")]
+    return [(f"level:{ref}", f"{path}: {said} (x{ratio:.3g}, more than {LEVEL_RTOL:.0%} off): the manifest's level "
+             f"or the channel's sensitivity is wrong; correct {LEVEL[kind]} of run {run} in manifest.csv or the "
+             f"channel's calibration {drop}.")]
 
 
 def _drive_band(ref: NDArray[np.float64], fs: float, f0: float, f1: float,

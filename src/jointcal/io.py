@@ -10,7 +10,9 @@ checks and writers are in private helper modules and re-exported).
 """
 from __future__ import annotations
 
+import gzip
 import os
+import re
 from pathlib import Path
 from typing import Any
 
@@ -28,7 +30,7 @@ from jointcal._contract import (
 
 __all__ = [
     "CampaignError", "CampaignWarning", "read_manifest", "read_run", "validate_run",
-    "ingest_campaign", "write_bytes_atomic", "write_csv_atomic", "write_json_atomic",
+    "ingest_campaign", "listed_record", "write_bytes_atomic", "write_csv_atomic", "write_json_atomic",
     "write_run",
 ]
 
@@ -62,6 +64,7 @@ def read_manifest(path: str | os.PathLike[str]) -> pd.DataFrame:
     path = Path(path)
     if not path.is_file():
         fail(path, "the manifest does not exist", "put manifest.csv (one row per run) in the campaign folder")
+    _check_delimiter(path)
     try:
         raw = pd.read_csv(path, dtype=str, keep_default_na=False, encoding="utf-8-sig")
     except (ValueError, UnicodeDecodeError) as exc:
@@ -80,6 +83,8 @@ def read_manifest(path: str | os.PathLike[str]) -> pd.DataFrame:
     if raw.empty:
         fail(path, "it lists no runs", "add one row per run")
     rows = [_manifest_row(rec, path, i + 2, levels[0]) for i, rec in enumerate(raw.to_dict("records"))]
+    for i, rec in enumerate(rows):
+        _check_name(rec, path, i + 2)
     df = pd.DataFrame(rows, columns=need + [c for c in raw.columns if c not in need])
     for keys in (["run_id"], ["file"], ["assembly", "sequence"]):
         dup = df.duplicated(keys, keep=False)
@@ -91,6 +96,39 @@ def read_manifest(path: str | os.PathLike[str]) -> pd.DataFrame:
                             for k in reversed(keys))
             fail(path, f"lines {lines} repeat {what}", f"make each {' within '.join(reversed(keys))} unique")
     return df
+
+
+DELIMITERS = {";": "semicolons", "\t": "tabs", "|": "vertical bars"}
+SAFE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._+-]*")  # a file name on every system, not a path
+
+
+def _check_delimiter(path: Path) -> None:
+    """Fail, naming the separator, when a CSV file's header is not split by commas."""
+    try:
+        with (gzip.open(path, "rt", encoding="utf-8-sig") if path.name.lower().endswith(".gz")
+              else open(path, encoding="utf-8-sig")) as fh:
+            head = fh.readline()
+    except (OSError, EOFError, UnicodeDecodeError):
+        return  # pandas' reader names the problem
+    if "," not in head:
+        for sep, name in DELIMITERS.items():
+            if head.count(sep) >= 2:
+                fail(path, f"its columns are separated by {name} ({sep!r}), not commas (header: {head.strip()!r})",
+                     "save it as comma-separated text with '.' as the decimal point")
+
+
+def _check_name(rec: dict[str, Any], path: Path, line: int) -> None:
+    """Fail unless run_id is a safe file name and assembly holds no path separator."""
+    rid, assembly = rec["run_id"], rec["assembly"]
+    where = f"{path}: line {line} (run_id {rid!r})"
+    if not SAFE_NAME.fullmatch(rid):
+        bad = sorted({c for c in rid if not re.fullmatch(r"[A-Za-z0-9._+-]", c)}) or [rid[0]]
+        fail(where, f"run_id {rid!r} is not a safe file name (it names the run's output files; "
+             f"{', '.join(map(repr, bad))} not allowed there)",
+             "use letters, digits, '.', '_', '+' and '-' only, starting with a letter or digit")
+    if any(c in assembly for c in "/\\") or assembly.startswith("."):
+        fail(where, f"assembly {assembly!r} is not a safe folder name (it names the calibration's output folder)",
+             "write it without '/' or '\\' and not starting with '.'")
 
 
 def _manifest_row(rec: dict[str, str], path: Path, line: int, level: str) -> dict[str, Any]:
@@ -162,6 +200,7 @@ def read_run(path: str | os.PathLike[str]) -> pd.DataFrame:
 
 
 def _read_csv(path: Path) -> dict[str, NDArray[np.float64]]:
+    _check_delimiter(path)
     try:
         df = pd.read_csv(path, skipinitialspace=True)
     except (OSError, EOFError, ValueError, UnicodeDecodeError) as exc:
@@ -236,3 +275,25 @@ def ingest_campaign(campaign_dir: str | os.PathLike[str], *,
         checks["flags"] = ";".join(checks["flags"])
         rows.append({**row.to_dict(), **checks})
     return pd.DataFrame(rows)
+
+
+def listed_record(file: str | os.PathLike[str], paths: list[str] | tuple[str, ...]) -> str | None:
+    """The path among `paths` that is the manifest's run `file`, matched on its whole relative path.
+
+    Parameters
+    ----------
+    file : path-like
+        The manifest's ``file`` cell (relative to the campaign folder).
+    paths : sequence of str
+        Paths of the campaign's run files (the campaign folder joined with each ``file``).
+
+    Returns
+    -------
+    str or None
+        The shortest path ending with all of `file`'s parts (``a/run.csv`` is not
+        ``b/a/run.csv``); None if none does. Never matched on the basename alone:
+        two folders may hold files of one name.
+    """
+    parts = Path(file).parts
+    hits = [p for p in paths if Path(p).parts[-len(parts):] == parts]
+    return min(hits, key=lambda p: len(Path(p).parts)) if hits else None

@@ -16,16 +16,20 @@ def main(smk) -> None:
     """Run the rule with Snakemake's ``snakemake`` object."""
     log = Path(smk.log[0])
     campaign = Path(smk.input.manifest).parent
-    try:
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
             runs = ingest_campaign(campaign, on_data_problem=smk.params.ingest["on_data_problem"])
-    except CampaignError as exc:
-        log.write_text(f"jointcal: {exc}\n")
-        sys.exit(f"jointcal: {exc}")
-    notes = [f"jointcal: warning: {w.message}" for w in caught]
+        except CampaignError as exc:
+            error = exc
+        else:
+            error = None
+    notes = [f"jointcal: warning: {w.message}" for w in caught]  # every warning, also before an error
     for note in notes:
         print(note, file=sys.stderr)
+    if error is not None:
+        log.write_text("\n".join([*notes, f"jointcal: {error}"]) + "\n")
+        sys.exit(f"jointcal: {error}")
     write_csv_atomic(runs, smk.output.runs)
     flagged = int((runs["flags"] != "").sum())
     notes.append(f"jointcal: ingested {len(runs)} runs ({flagged} flagged) from {campaign}")

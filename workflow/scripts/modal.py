@@ -9,14 +9,15 @@ from pathlib import Path
 
 import pandas as pd
 
-from jointcal.io import read_run, write_csv_atomic
+from jointcal._checks import UNUSABLE_FLAGS
+from jointcal.io import listed_record, read_run, write_csv_atomic
 from jointcal.modal import FLAG_WORDS, modal_properties, scatter
 
 
 def main(smk) -> None:
     runs = pd.read_csv(smk.input.runs, dtype={"flags": str})
     env_dir = Path(smk.input.env[0]).parent
-    raw = {Path(p).name: p for p in smk.input.records}
+    records = list(smk.input.records)
     rows, notes = [], []
     for row in runs.to_dict("records"):
         rid = row["run_id"]
@@ -28,10 +29,16 @@ def main(smk) -> None:
             out["flags"] = ";".join(ingest_flags + ["unusable"])
             notes.append(f"{rid}: {meta['error']}")
         else:
-            record = read_run(raw[Path(row["file"]).name]) if Path(row["file"]).name in raw else None
+            path = listed_record(str(row["file"]), records)  # whole relative path: basenames may repeat
+            record = read_run(path) if path else None
             out = modal_properties(env, row, rate_hz_per_s=meta["rate_hz_per_s"], record=record, **smk.params.modal)
             out["flags"] = ";".join(dict.fromkeys(ingest_flags + [f for f in out["flags"].split(";") if f]))
             out["window_s"] = meta["window_s"]
+        wrong = [f for f in ingest_flags if f.split(":")[0] in UNUSABLE_FLAGS]
+        if wrong and "unusable" not in out["flags"].split(";"):  # wrong units, level, channels; clipped: no fit
+            out["flags"] = ";".join([*out["flags"].split(";"), "unusable"]).lstrip(";")
+            notes.append(f"{rid}: unusable: ingest flagged {', '.join(wrong)} (see the ingest log); "
+                         "left out of the calibration")
         for flag in [f for f in out["flags"].split(";") if f.split(":")[0] in FLAG_WORDS or ":" in f]:
             notes.append(f"{rid}: {flag.split(':')[0]}: {FLAG_WORDS.get(flag.split(':')[0], flag)}.")
         rows.append(out)

@@ -3,7 +3,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from jointcal.io import read_run
+from jointcal.io import listed_record, read_run
 from jointcal.report.modal import plot_envelopes, plot_frequency_damping, plot_spectrogram
 from jointcal.signal import window_length
 
@@ -17,12 +17,11 @@ def main(smk) -> None:
     level = "level_g" if "level_g" in runs.columns else "level_lbf"
     rid = runs.sort_values([level, "sequence"]).iloc[-1]["run_id"]  # the strongest run
     row = runs.loc[rid]
-    raw = {Path(p).name: p for p in smk.input.records}
     lo = min(row["f_start_hz"], row["f_stop_hz"])
     n = window_length(row["sample_rate_hz"], row["sweep_rate_hz_per_s"], lo, **{
         k: v for k, v in smk.params.envelopes.items() if k == "zeta_min"})
-    plot_spectrogram(read_run(raw[Path(row["file"]).name]), envs[rid], row["sample_rate_hz"], n, rid,
-                     smk.output.spectrogram)
+    record = read_run(listed_record(row["file"], list(smk.input.records)))  # whole path: basenames may repeat
+    plot_spectrogram(record, envs[rid], row["sample_rate_hz"], n, rid, smk.output.spectrogram)
     Path(smk.log[0]).write_text(f"jointcal: figures written; spectrogram of {rid}\n")
 
 

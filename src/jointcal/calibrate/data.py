@@ -4,7 +4,9 @@ Reads ``modal_properties.csv`` (one row per run: ``run_id, assembly, q_in, f_res
 the damping column named in the config, ``flags``; ``level_g`` or ``level_lbf`` is
 carried along when present) and ``scatter.csv``
 (tidy repeatability: ``assembly, quantity, level_g, source, n, mean, std, rel_std``).
-Rows whose ``flags`` name ``unusable`` are left out; other flags are informational.
+Rows whose ``flags`` name ``unusable``, or an ingest flag of wrong units or level,
+swapped channels, a constant channel or clipping (`jointcal._checks.UNUSABLE_FLAGS`),
+are left out; other flags are informational.
 The pooled relative scatter of the frequency and of the chosen damping estimator is the
 likelihood's noise floor; a missing, zero or tiny pooled value is replaced by a floor
 from the config, and the replacement is reported in `ModalData.notes`. Every problem
@@ -21,6 +23,8 @@ from typing import Literal, NoReturn
 import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
+
+from jointcal._checks import UNUSABLE_FLAGS
 
 __all__ = ["CalibrationInputError", "ModalData", "DAMPING", "select_modal", "read_modal", "read_table"]
 
@@ -70,8 +74,11 @@ class ModalData:
 
 
 def _usable(flags: pd.Series) -> NDArray[np.bool_]:
+    """False for runs flagged unusable or with an ingest flag in UNUSABLE_FLAGS (units, level, channels, clipping)."""
     text = flags.map(lambda v: "" if pd.isna(v) else str(v))
-    return ~text.map(lambda t: any("unusable" in tok.strip().lower() for tok in t.split(";"))).to_numpy(bool)
+    return ~text.map(lambda t: any("unusable" in tok.strip().lower()
+                                   or tok.strip().split(":")[0] in UNUSABLE_FLAGS for tok in t.split(";"))
+                     ).to_numpy(bool)
 
 
 def _pooled(scatter: pd.DataFrame, assembly: str, quantity: str, floor: float, where: object,

@@ -97,6 +97,46 @@ def _coerce(s: dict, where: str) -> None:
         m["full_scale_g"][ch] = v if v == "auto" else _number(v, where, f"measurement.full_scale_g.{ch}")
 
 
+def _parse(path: Path):
+    """The YAML or JSON document in `path`; a syntax error is one sentence naming the line."""
+    try:
+        text = path.read_text()
+        return json.loads(text) if path.suffix == ".json" else yaml.safe_load(text)
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{path}: not valid JSON at line {exc.lineno}, column {exc.colno} ({exc.msg}); "
+                         "fix the syntax there.") from None
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        at = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+        problem = getattr(exc, "problem", None) or type(exc).__name__
+        raise ValueError(f"{path}: not valid YAML{at} ({problem}); fix the syntax there "
+                         "(indent nested keys by spaces, quote text holding ':' or '#').") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"{path}: cannot be read ({exc}); give a readable YAML or JSON text file.") from None
+
+
+SHAPES = {"sweep": dict, "series": list, "assemblies": dict, "measurement": dict, "effect": dict}
+
+
+def _check_shapes(s: dict, where: str) -> None:
+    """One sentence when a section has the wrong kind (a mapping for a list, a number for a mapping, ...)."""
+    word = {dict: "a mapping of keys", list: "a list"}
+    for key, kind in SHAPES.items():
+        if not isinstance(s[key], kind):
+            hint = " of {level_g, directions, repeats} items, each starting with '- '" if key == "series" else ""
+            raise ValueError(f"{where}: {key} must be {word[kind]}{hint}, got {type(s[key]).__name__} "
+                             f"{s[key]!r:.60}; write it as in jointcal.synth.spec's DEFAULT_SPEC.")
+    for i, item in enumerate(s["series"]):
+        if not isinstance(item, dict):
+            raise ValueError(f"{where}: series item {i + 1} must be a mapping {{level_g, directions, repeats}}, "
+                             f"got {item!r:.60}; write each item as '- {{level_g: 1.0, directions: [up, down], "
+                             "repeats: 1}'.")
+    m = s["measurement"]
+    if not isinstance(m.get("full_scale_g"), dict) or not isinstance(m.get("distortion"), list):
+        raise ValueError(f"{where}: measurement.full_scale_g must be a mapping {{base, response}} and "
+                         "measurement.distortion a list [2nd, 3rd]; write them as in DEFAULT_SPEC.")
+
+
 def load_spec(spec: dict | str | os.PathLike) -> dict:
     """Complete a spec with the defaults and validate it (one clear error per problem)."""
     where = "spec"
@@ -106,8 +146,7 @@ def load_spec(spec: dict | str | os.PathLike) -> dict:
         where, root = str(path), path.parent
         if not path.is_file():
             raise ValueError(f"{path}: spec file not found; give the path of a YAML or JSON truth spec.")
-        text = path.read_text()
-        spec = json.loads(text) if path.suffix == ".json" else yaml.safe_load(text)
+        spec = _parse(path)
         if not isinstance(spec, dict):
             raise ValueError(f"{path}: a spec must be a mapping of keys (seed, assemblies, ...).")
     unknown = set(spec) - set(DEFAULT_SPEC) - {"seed", "effect_file"}
@@ -120,7 +159,8 @@ def load_spec(spec: dict | str | os.PathLike) -> dict:
         ef = root / s.pop("effect_file")
         if not ef.is_file():
             raise ValueError(f"{where}: effect_file {ef} not found; fix the path (relative to the spec).")
-        s["effect"] = (json.loads if ef.suffix == ".json" else yaml.safe_load)(ef.read_text())
+        s["effect"] = _parse(ef)
+    _check_shapes(s, where)
     s["effect"] = {"name": s["effect"].get("name", "none"), "params": s["effect"].get("params") or {}}
     _coerce(s, where)
     effect_defaults(s["effect"]["name"], s["effect"]["params"])
