@@ -1,0 +1,253 @@
+"""Whole-record frequency response of a run and a single-mode fit of its peak.
+
+What a lab's FRF software does with a swept-sine or chirp record:
+
+* ``h1_estimate``: the H1 estimate of response / reference over the whole record
+  (`scipy.signal.csd` / `scipy.signal.welch` with ONE boxcar segment holding the whole
+  sweep and its free decay, zero-padded). For a linear structure excited from rest
+  whose response has died out by the record's end this is the exact FRF at any sweep
+  rate: no sweep-rate bias, unlike time-local envelopes or Welch averages of shorter
+  segments (which bias a lightly damped peak by a few % because each segment cuts the
+  ring-down). With one segment H1 = H2 and the coherence is 1 by construction, so H2
+  and the coherence are also given from spectra averaged over `n_band` neighbouring
+  lines (a Daniell estimate): diagnostics of noise on the reference (H1 < H2) and of
+  distortion, not the values fitted.
+* ``fit_mode``: resonance and damping from a single-degree-of-freedom rational fit
+  of the peak region of the displacement ratio (receptance, or relative displacement
+  over base acceleration), with residual terms for the modes outside the band:
+  ``X(w) = A / (w_n^2 - w^2 + 2 i zeta w_n w) + R_0 + R_2 / w^2`` with complex A, R_0,
+  R_2 (a complex modal constant covers an amplifier voltage reference, whose phase to
+  the force is not zero). w_n and zeta by least squares, the linear terms by variable
+  projection; the fit's relative RMS residual is reported.
+
+For a nonlinear structure (a bolted joint) the H1 of a sweep is the equivalent FRF at
+that drive level: each line is the response to the drive at that frequency at the
+amplitude the structure had when the sweep crossed it. Near the peak of a slow sweep
+the fitted w_n is the quadrature frequency at the peak amplitude, i.e. the
+equivalent-linear (harmonic-balance) natural frequency at the run's level; a fast chirp
+never builds the steady-state amplitude, so it shows the structure at a smaller one.
+
+Reference kinds (`jointcal._contract.REFERENCE`): base acceleration (g; the ratio is
+the relative displacement z over the base acceleration, whose modal constant is -m/m),
+force (lbf; receptance x/F) and amplifier voltage (V; x/V is the rig's FRF, the shaker
+included: only its phase and ratios carry information, no damping can be taken from an
+absolute force).
+"""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import pandas as pd
+from numpy.typing import NDArray
+from scipy import signal
+from scipy.ndimage import uniform_filter1d
+from scipy.optimize import least_squares
+
+from .models import G
+
+__all__ = ["ModeFit", "h1_estimate", "displacement_ratio", "fit_mode", "record_frf", "frf_table"]
+
+
+@dataclass(frozen=True)
+class ModeFit:
+    """A single-mode fit of an FRF peak.
+
+    f_n_hz : natural frequency |lambda| / 2 pi (Hz); for a real modal constant the
+        quadrature (phase resonance) frequency.
+    zeta : damping ratio -Re(lambda) / |lambda|.
+    residual : relative RMS misfit over the fitted lines, ||X - fit|| / ||X||.
+    n_lines : number of frequency lines fitted.
+    f_lo_hz, f_hi_hz : the fitted band (Hz).
+    truncated : the response had not died out at the record's end (ratio of the
+        response's RMS over the last 1% of the record to its peak; > 0.01 leaks).
+    """
+
+    f_n_hz: float
+    zeta: float
+    residual: float
+    n_lines: int
+    f_lo_hz: float
+    f_hi_hz: float
+    truncated: float
+
+
+def h1_estimate(ref: NDArray, resp: NDArray, fs: float, *, n_band: int = 5, pad: int = 4) -> pd.DataFrame:
+    """Whole-record H1 of resp / ref, with band-averaged H2 and coherence.
+
+    Parameters
+    ----------
+    ref, resp : ndarray, shape (n,)
+        Reference (any unit) and response channels, sampled at `fs`; NaN samples
+        count as zero (flag the run elsewhere).
+    fs : float
+        Sample rate, Hz.
+    n_band : int
+        Lines averaged (moving mean) for the diagnostic H2 and coherence.
+    pad : int
+        Zero-padding factor (FFT length >= pad * n): interpolated lines for the fit.
+
+    Returns
+    -------
+    DataFrame, one row per line from 0 to fs/2
+        freq_hz; h1_re, h1_im (resp unit / ref unit, whole record); h1s_re, h1s_im,
+        h2_re, h2_im (band-averaged); coherence (0..1, band-averaged).
+    """
+    x = np.nan_to_num(np.asarray(ref, float))
+    y = np.nan_to_num(np.asarray(resp, float))
+    x, y = x - np.median(x), y - np.median(y)
+    n = x.size
+    nfft = 1 << int(np.ceil(np.log2(pad * n)))
+    kw = dict(fs=fs, window="boxcar", nperseg=n, noverlap=0, nfft=nfft, detrend=False)
+    f, pxy = signal.csd(x, y, **kw)  # conj(X) Y
+    _, pxx = signal.welch(x, **kw)
+    _, pyy = signal.welch(y, **kw)
+    h1 = pxy / np.where(pxx > 0, pxx, np.inf)
+    w = max(1, int(n_band)) * (nfft // n)  # n_band independent lines (padding interpolates)
+    sxy = uniform_filter1d(pxy.real, w) + 1j * uniform_filter1d(pxy.imag, w)
+    sxx, syy = uniform_filter1d(pxx, w), uniform_filter1d(pyy, w)
+    h1s = sxy / np.where(sxx > 0, sxx, np.inf)
+    h2 = syy / np.where(np.abs(sxy) > 0, np.conj(sxy), np.inf)
+    coh = np.abs(sxy) ** 2 / np.where(sxx * syy > 0, sxx * syy, np.inf)
+    return pd.DataFrame(dict(freq_hz=f, h1_re=h1.real, h1_im=h1.imag, h1s_re=h1s.real, h1s_im=h1s.imag,
+                             h2_re=h2.real, h2_im=h2.imag, coherence=np.clip(coh, 0.0, 1.0)))
+
+
+def displacement_ratio(f: NDArray, h_accel: NDArray, kind: str) -> NDArray:
+    """The displacement ratio fitted, from the acceleration FRF.
+
+    Parameters
+    ----------
+    f : ndarray, Hz;  h_accel : complex ndarray
+        Response acceleration (g) over the reference (g, lbf or V).
+    kind : {'base', 'force', 'voltage'}
+        Reference kind. Base: relative displacement over base acceleration,
+        z / a_b = -(H - 1) / w^2 (in/g); otherwise x / ref = -H G / w^2 (in/lbf, in/V).
+    """
+    w2 = (2 * np.pi * np.asarray(f, float)) ** 2
+    w2 = np.where(w2 > 0, w2, np.inf)
+    return -(h_accel - 1.0) * G / w2 if kind == "base" else -h_accel * G / w2
+
+
+def _basis(w: NDArray, wn: float, zeta: float) -> NDArray:
+    return np.stack([1.0 / (wn**2 - w**2 + 2j * zeta * wn * w), np.ones_like(w, complex), 1.0 / w**2], axis=1)
+
+
+def _project(w: NDArray, X: NDArray, wn: float, zeta: float):
+    """Linear terms (A, R_0, R_2) by least squares for given w_n, zeta; returns (coef, misfit)."""
+    B = _basis(w, wn, zeta)
+    s = np.abs(B).max(axis=0)
+    coef, *_ = np.linalg.lstsq(B / s, X, rcond=None)
+    return coef / s, X - B @ (coef / s)
+
+
+def _half_power_zeta(f: NDArray, a: NDArray, ip: int) -> float:
+    """Damping ratio from the half-power width of |X| around line ip (a rough start)."""
+    lvl = a[ip] / np.sqrt(2)
+    lo = np.flatnonzero(a[:ip] < lvl)
+    hi = np.flatnonzero(a[ip:] < lvl)
+    f_lo = f[lo[-1]] if lo.size else f[0]
+    f_hi = f[ip + hi[0]] if hi.size else f[-1]
+    return float(np.clip((f_hi - f_lo) / (2 * f[ip]), 1e-4, 0.3))
+
+
+def fit_mode(f: NDArray, X: NDArray, f_band: tuple[float, float], *, span: float = 2.0,
+             f_guess: float | None = None) -> ModeFit:
+    """Single-mode rational fit of the strongest peak of X in f_band.
+
+    Parameters
+    ----------
+    f : ndarray, Hz;  X : complex ndarray
+        Displacement ratio (see `displacement_ratio`) on the lines f.
+    f_band : (lo, hi), Hz
+        Where to look for the peak (the driven band).
+    span : float
+        Half-width of the fitted band in half-power bandwidths: lines within
+        f_n (1 +- span zeta). 2 keeps the peak region (|X| > 0.45 of the peak), where
+        the single mode dominates and a nonlinear structure's amplitude is near its
+        peak value; the residual terms take the rest.
+    f_guess : float, optional
+        Start near this frequency (Hz) instead of the largest |X| in the band.
+
+    Returns
+    -------
+    ModeFit (truncated = NaN; `record_frf` fills it).
+    """
+    lo, hi = f_band
+    inb = np.flatnonzero((f >= lo) & (f <= hi) & np.isfinite(X))
+    if inb.size < 8:
+        raise ValueError(f"fewer than 8 FRF lines in {lo:g}-{hi:g} Hz; record a longer sweep.")
+    a = np.abs(X[inb])
+    ip = int(np.argmax(a)) if f_guess is None else int(np.argmin(np.abs(f[inb] - f_guess)))
+    fn, zeta = float(f[inb][ip]), _half_power_zeta(f[inb], a, ip)
+    for _ in range(3):  # the fitted band follows the fitted mode
+        sel = inb[np.abs(f[inb] - fn) <= span * max(zeta, 2 * (f[1] - f[0]) / fn) * fn]
+        if sel.size < 6:
+            sel = inb[np.argsort(np.abs(f[inb] - fn))[:6]]
+        w, Xs = 2 * np.pi * f[sel], X[sel]
+        scale = np.linalg.norm(Xs)
+
+        def misfit(p):
+            r = _project(w, Xs / scale, np.exp(p[0]), np.exp(p[1]))[1]
+            return np.concatenate([r.real, r.imag])
+
+        sol = least_squares(misfit, [np.log(2 * np.pi * fn), np.log(zeta)], x_scale=[1e-3, 0.1], method="lm")
+        fn_new, zeta = float(np.exp(sol.x[0]) / (2 * np.pi)), float(np.exp(sol.x[1]))
+        done = abs(fn_new / fn - 1) < 1e-6
+        fn = fn_new
+        if done:
+            break
+    res = float(np.linalg.norm(_project(w, Xs, 2 * np.pi * fn, zeta)[1]) / scale)
+    return ModeFit(f_n_hz=fn, zeta=zeta, residual=res, n_lines=int(sel.size), f_lo_hz=float(f[sel].min()),
+                   f_hi_hz=float(f[sel].max()), truncated=float("nan"))
+
+
+def record_frf(ref: NDArray, resp_g: NDArray, fs: float, kind: str, f_band: tuple[float, float], *,
+               span: float = 2.0, f_guess: float | None = None, n_band: int = 5):
+    """A run's whole-record FRF and the fit of its resonance.
+
+    Parameters
+    ----------
+    ref : ndarray, shape (n,)
+        Reference channel: base acceleration (g), force (lbf) or drive voltage (V).
+    resp_g : ndarray, shape (n,)
+        Response acceleration, g.
+    fs : float
+        Sample rate, Hz.
+    kind : {'base', 'force', 'voltage'}
+        Reference kind.
+    f_band : (lo, hi), Hz
+        The driven band.
+
+    Returns
+    -------
+    table : DataFrame
+        `h1_estimate`'s columns restricted to f_band, plus x_re, x_im (the
+        displacement ratio fitted; in/g, in/lbf or in/V) and fit_re, fit_im (the fitted
+        model on the fitted lines, NaN elsewhere).
+    fit : ModeFit
+    """
+    tab = h1_estimate(ref, resp_g, fs, n_band=n_band)
+    f = tab["freq_hz"].to_numpy()
+    keep = (f >= f_band[0]) & (f <= f_band[1])
+    tab = tab[keep].reset_index(drop=True)
+    f = f[keep]
+    X = displacement_ratio(f, (tab["h1_re"] + 1j * tab["h1_im"]).to_numpy(), kind)
+    fit = fit_mode(f, X, f_band, span=span, f_guess=f_guess)
+    y = np.nan_to_num(np.asarray(resp_g, float))
+    y = y - np.median(y)
+    tail = y[-max(8, y.size // 100):]
+    trunc = float(np.sqrt(np.mean(tail**2)) / max(np.max(np.abs(y)), 1e-300))
+    fit = ModeFit(**{**asdict(fit), "truncated": trunc})
+    sel = (f >= fit.f_lo_hz) & (f <= fit.f_hi_hz)
+    w = 2 * np.pi * f
+    coef, _ = _project(w[sel], X[sel], 2 * np.pi * fit.f_n_hz, fit.zeta)
+    model = np.full(f.size, np.nan, complex)
+    model[sel] = _basis(w[sel], 2 * np.pi * fit.f_n_hz, fit.zeta) @ coef
+    tab = tab.assign(x_re=X.real, x_im=X.imag, fit_re=model.real, fit_im=model.imag)
+    return tab, fit
+
+
+def frf_table(tab: pd.DataFrame, run_id: str) -> pd.DataFrame:
+    """`record_frf`'s table with the run id in front (tidy: one row per run and line)."""
+    return tab.assign(run_id=run_id)[["run_id", *tab.columns]]
