@@ -1,0 +1,246 @@
+"""An electrodynamic shaker driven open-loop by an amplifier's voltage, coupled to the structure.
+
+The structure (slug of mass m on the spring k in parallel with the joint, dashpot c,
+on a rigid base) is driven at the slug through a stiff stinger and a force gauge by a
+shaker: armature mass m_a on its suspension (k_s, c_s), coil of resistance R and
+inductance L in a magnetic field (force constant Bl, lbf/A; back-EMF constant
+Bl_e = Bl * 0.1129848 V/(in/s), the same constant in SI). With the stinger rigid the
+armature moves with the slug, x:
+
+    (m + m_a) x'' + (c + c_s) x' + (k + KT + k_s) x + r_nl = Bl i      (mechanics)
+    L i' + R i + Bl_e x' = V                                          (coil)
+    F = Bl i - m_a x'' - c_s x' - k_s x                               (force gauge)
+
+so the force the gauge reads is m x'' + c x' + k x + F_joint(x): the structure's own
+dynamic stiffness times x, which is smallest at the structure's resonance (the force
+drops out there), and the ratio response / voltage is the rig's FRF, the shaker's
+mass, suspension and electrical damping Bl Bl_e / R included. The joint's nonlinear
+remainder r_nl = F_iwan - KT x (and the effects' k3, c2 terms) enters as in
+`jointcal.models.simulate`, whose exact-Iwan kernel integrates this 3-state system.
+
+Truth at a drive level V0 (`rig_truth`): the steady-state amplitude at resonance from
+the equivalent-linear (first-harmonic) coupled FRF, and there the structure's own
+natural frequency and damping (what H1 of response / force shows) and the rig's pole
+(what H1 of response / voltage shows).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..models import G, MinistackModel, harmonic_balance
+from ..models import _integrator
+from ..models._masing import kernel_constants
+from ..models.iwan import derived
+from ..models.simulate import _substep_maps, fractional_delay, hermite_propagator
+
+__all__ = ["Shaker", "BL_E_PER_BL", "rig_matrices", "simulate_rig", "structure_equivalent", "rig_pole",
+           "steady_amplitude", "rig_truth"]
+
+BL_E_PER_BL = 4.448222 * 0.0254  # V/(in/s) of back-EMF per lbf/A of force constant (= 1 in SI)
+
+
+@dataclass(frozen=True)
+class Shaker:
+    """Electrodynamic shaker parameters (units lbf, in, s, A, V, ohm, H).
+
+    armature_weight_lbf : moving weight on the shaker side of the force gauge, lbf.
+    suspension_hz : the armature's own frequency on its flexures, Hz.
+    suspension_zeta : their damping ratio.
+    bl_lbf_per_A : force constant Bl, lbf/A.
+    coil_ohm : coil resistance (plus the amplifier's output resistance), ohm.
+    coil_mH : coil inductance, mH.
+    """
+
+    armature_weight_lbf: float = 0.25
+    suspension_hz: float = 20.0
+    suspension_zeta: float = 0.05
+    bl_lbf_per_A: float = 2.0
+    coil_ohm: float = 1.5
+    coil_mH: float = 0.15
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if not (np.isfinite(v) and v > 0):
+                raise ValueError(f"shaker.{f.name} must be a positive number, got {v!r}.")
+
+    @property
+    def m_a(self) -> float:
+        """Armature mass, lbf s^2/in."""
+        return self.armature_weight_lbf / G
+
+    @property
+    def k_s(self) -> float:
+        """Suspension stiffness, lbf/in."""
+        return self.m_a * (2 * np.pi * self.suspension_hz) ** 2
+
+    @property
+    def c_s(self) -> float:
+        """Suspension damping, lbf s/in."""
+        return 2 * self.suspension_zeta * np.sqrt(self.k_s * self.m_a)
+
+
+def _structure(model: MinistackModel) -> tuple[float, float, float]:
+    """Stuck-joint stiffness k + KT (lbf/in), dashpot c (lbf s/in) and mass (lbf s^2/in)."""
+    if model.fixture is not None:
+        raise ValueError("a shaker rig drives the slug on a rigid base: the fixture_flexibility effect does not apply; "
+                         "use reference: base for it.")
+    ks = model.k + model.KT
+    return ks, 2.0 * model.zeta_v * np.sqrt(ks * model.m), model.m
+
+
+def rig_matrices(model: MinistackModel, shaker: Shaker):
+    """State space of the coupled rig, state [x (in), x' (in/s), i (A)], input V (volts).
+
+    Returns
+    -------
+    A (3, 3), bu (3,), bf (3,) : x' = A x + bu V + bf r_nl
+    out : dict of (c, du, df) per output, y = c.x + du V + df r_nl:
+        'accel' (in/s^2) and 'force' (lbf, the gauge).
+    """
+    ks, c, m = _structure(model)
+    M, K, C = m + shaker.m_a, ks + shaker.k_s, c + shaker.c_s
+    Bl, Ble = shaker.bl_lbf_per_A, shaker.bl_lbf_per_A * BL_E_PER_BL
+    L, R = shaker.coil_mH * 1e-3, shaker.coil_ohm
+    A = np.array([[0.0, 1.0, 0.0], [-K / M, -C / M, Bl / M], [0.0, -Ble / L, -R / L]])
+    bu = np.array([0.0, 0.0, 1.0 / L])
+    bf = np.array([0.0, -1.0 / M, 0.0])
+    acc = (A[1].copy(), 0.0, -1.0 / M)
+    ma = shaker.m_a
+    force = (np.array([-shaker.k_s, -shaker.c_s, Bl]) - ma * A[1], 0.0, ma / M)
+    return A, bu, bf, {"accel": acc, "force": force}
+
+
+def simulate_rig(model: MinistackModel, shaker: Shaker, volts: NDArray, fs: float, *, omega_h: float = 0.3):
+    """Response acceleration (g), gauge force (lbf) and displacement (in) under a drive voltage.
+
+    Parameters
+    ----------
+    model : MinistackModel
+        The structure (joint, k, zeta_v, mass; effects k3, c2, sensor_gain,
+        sensor_delay_s apply as in `jointcal.models.simulate`).
+    shaker : Shaker
+    volts : ndarray, shape (N,)
+        Amplifier output voltage, V, sampled at fs; the rig starts at rest.
+    fs : float
+        Sample rate, Hz.
+    omega_h : float
+        Largest w_0 h of the integration substeps at the coupled stuck-joint frequency.
+
+    Returns
+    -------
+    accel_g, force_lbf, x_in : ndarray, shape (N,)
+    """
+    u = np.ascontiguousarray(volts, dtype=float)
+    A, bu, bf, outs = rig_matrices(model, shaker)
+    ks, _, m = _structure(model)
+    w0 = np.sqrt((ks + shaker.k_s) / (m + shaker.m_a))
+    n_sub = max(1, int(np.ceil(w0 / (omega_h * fs))))
+    H = 1.0 / fs
+    h = H / n_sub
+    Phi, Gu = hermite_propagator(A, bu, h)
+    _, Gf = hermite_propagator(A, bf, h)
+    Gsub, Wub = _substep_maps(Gu, n_sub)
+    lz, lv = np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
+    az, bzu, bzf = lv @ A, float(lv @ bu), float(lv @ bf)
+    if model.iwan is None:
+        joint, KT, R, chi, phimax, Fs = 0, 0.0, 0.0, 0.5, 1.0, 0.0
+    else:
+        p = model.iwan
+        phimax, R, _ = (float(a) for a in derived(p.Fs, p.KT, p.chi, p.beta))
+        R, chi = kernel_constants(R, p.chi)
+        joint, KT, Fs = 1, p.KT, p.Fs
+    res = {}
+    for name, (cy, dyu, dyf) in outs.items():  # the same trajectory twice, two outputs
+        y, x = np.empty_like(u), np.empty_like(u)
+        _integrator.run(u, _integrator.rate(u, fs), H, Gsub, Wub, np.ascontiguousarray(Phi),
+                        np.ascontiguousarray(Gf), lz, lv, az, bzu, bzf, np.ascontiguousarray(cy), float(dyu),
+                        float(dyf), joint, KT, R, chi, phimax, Fs, np.zeros(0), np.zeros(0), float(model.k3),
+                        float(model.c2), y, x)
+        res[name] = y
+    acc = res["accel"]
+    if model.sensor_delay_s != 0.0:
+        acc = fractional_delay(acc, model.sensor_delay_s, fs)
+    return acc * model.sensor_gain / G, res["force"], x
+
+
+def structure_equivalent(model: MinistackModel, q: float) -> tuple[float, float]:
+    """The structure's equivalent-linear natural frequency (Hz) and damping at amplitude q (in).
+
+    First-harmonic balance of the joint (`jointcal.models.harmonic_balance`, dashpot
+    viscous term); a linear structure (no joint) gives sqrt(k/m) and zeta_v.
+    """
+    if model.iwan is None:
+        return float(np.sqrt(model.k / model.m) / (2 * np.pi)), float(model.zeta_v)
+    p = model.iwan
+    f, z = harmonic_balance(q, p.Fs, p.KT, p.chi, p.beta, model.k, model.m, model.zeta_v)
+    return float(f), float(z)
+
+
+def _rig_poly(model: MinistackModel, shaker: Shaker, q: float):
+    """Characteristic polynomial (in s) of the equivalent-linear rig at amplitude q."""
+    f, z = structure_equivalent(model, q)
+    w = 2 * np.pi * f
+    m = model.m
+    M, K, C = m + shaker.m_a, m * w**2 + shaker.k_s, 2 * z * m * w + shaker.c_s
+    Bl, Ble, L, R = shaker.bl_lbf_per_A, shaker.bl_lbf_per_A * BL_E_PER_BL, shaker.coil_mH * 1e-3, shaker.coil_ohm
+    return np.polymul([L, R], [M, C, K]) + np.array([0.0, 0.0, Bl * Ble, 0.0]), Bl
+
+
+def rig_pole(model: MinistackModel, shaker: Shaker, q: float) -> tuple[float, float]:
+    """The rig's structural pole at amplitude q: |lambda| / 2 pi (Hz) and -Re(lambda) / |lambda|."""
+    den, _ = _rig_poly(model, shaker, q)
+    r = np.roots(den)
+    r = r[np.imag(r) > 0]
+    f0 = structure_equivalent(model, q)[0]
+    lam = r[np.argmin(np.abs(np.abs(r) - 2 * np.pi * f0))]
+    return float(abs(lam) / (2 * np.pi)), float(-lam.real / abs(lam))
+
+
+def steady_amplitude(model: MinistackModel, shaker: Shaker, volts: float, *, iterations: int = 60) -> float:
+    """Steady-state displacement amplitude (in) at the rig's resonance under a voltage amplitude (V).
+
+    Solves q = V max_w |x/V(w; q)| by bisection in log q, with the joint's
+    equivalent-linear stiffness and damping at q (first harmonic).
+    """
+    def peak(q):
+        den, Bl = _rig_poly(model, shaker, q)
+        f, _ = structure_equivalent(model, q)
+        w = 2 * np.pi * f * np.linspace(0.7, 1.3, 4001)
+        return volts * np.max(np.abs(Bl / np.polyval(den, 1j * w)))
+
+    if model.iwan is None:
+        return float(peak(1.0))
+    phimax = float(derived(model.iwan.Fs, model.iwan.KT, model.iwan.chi, model.iwan.beta)[0])
+    lo, hi = np.log(1e-9 * phimax), np.log(1e3 * phimax)
+    for _ in range(iterations):
+        mid = 0.5 * (lo + hi)
+        if peak(np.exp(mid)) > np.exp(mid):
+            lo = mid
+        else:
+            hi = mid
+    return float(np.exp(0.5 * (lo + hi)))
+
+
+def rig_truth(model: MinistackModel, shaker: Shaker, volts: float, q_reached: float) -> dict:
+    """Truth of one rig run at drive amplitude `volts` (V).
+
+    Returns
+    -------
+    dict
+        q_ss_in (steady-state amplitude at resonance, in); f_hb_hz, zeta_hb (the
+        structure alone at q_ss: what H1 of response / force shows); f_rig_hz, zeta_rig
+        (the rig's pole at q_ss: what H1 of response / voltage shows); the same four at
+        q_reached_in, the largest amplitude the simulated sweep reached (a fast chirp
+        never builds the steady state), suffixed _reached.
+    """
+    q = steady_amplitude(model, shaker, volts)
+    out = dict(q_ss_in=q, q_reached_in=float(q_reached))
+    for sfx, qq in (("", q), ("_reached", float(q_reached))):
+        f, z = structure_equivalent(model, qq)
+        fr, zr = rig_pole(model, shaker, qq)
+        out.update({f"f_hb_hz{sfx}": f, f"zeta_hb{sfx}": z, f"f_rig_hz{sfx}": fr, f"zeta_rig{sfx}": zr})
+    return out
