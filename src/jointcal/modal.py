@@ -49,6 +49,8 @@ FLAG_WORDS = {
     "bad_samples": "NaN/inf or clipped samples; frames touching them were left out",
     "no_half_power": "a half-power point lies outside the record",
     "frf_truncated": "the response had not died out at the record's end; the whole-record FRF leaks",
+    "frf_misfit": "the single-mode fit leaves more than frf_misfit of the FRF's peak unexplained (a nonlinear "
+                  "transient, overlapping modes or noise): the FRF read-out is doubtful",
     "unusable": "no resonance could be estimated from this run",
 }
 
@@ -87,6 +89,7 @@ def _kind(row: dict, record: pd.DataFrame | None) -> str:
 
 def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass_lbf: float = 2.65,
                      eta_max: float = 0.5, eta_frf: float = 4.0, snr_min_db: float = 20.0, frf_span: float = 2.0,
+                     frf_misfit: float = 0.05,
                      record: pd.DataFrame | None = None, with_frf: bool = False):
     """Resonance, damping, amplitudes and flags of one run (one row of modal_properties.csv).
 
@@ -107,6 +110,10 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
         the measured phase slope (eta_max) and replaced by the FRF fit (eta_frf).
     frf_span : float
         Half-width of the FRF fit band in half-power bandwidths (`jointcal.frf.fit_mode`).
+    frf_misfit : float
+        Relative RMS residual of the FRF fit above which the run is flagged 'frf_misfit'
+        (a linear single mode with 0.3% noise fits to ~0.1%; the Table 3.2 joint's
+        distorted peaks at eta 0.1-5 to 1-9%, its eta-20 chirp's transient to 16-60%).
     record : DataFrame, optional
         The raw record, for the whole-record FRF (`jointcal.frf`).
     with_frf : bool
@@ -135,15 +142,20 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
     f_res, method = env_out["f_res_hz"], env_out["f_res_method"]
     eta = env_out.pop("eta_value")
     if fit is not None:
-        if not np.isfinite(eta):
-            eta = rate_hz_per_s / (fit.f_n_hz * fit.zeta) ** 2
+        eta_frf_fit = rate_hz_per_s / (fit.f_n_hz * fit.zeta) ** 2
+        eta = eta if np.isfinite(eta) and kind == "base" else eta_frf_fit  # a force's zeta needs the mass
         if kind != "base" or eta > eta_frf or method in ("peak", "none"):
             f_res, method = (fit.f_quad_hz if np.isfinite(fit.f_quad_hz) else fit.f_n_hz), "frf_fit"
             flags = [f for f in flags if f != "no_quadrature"]
-            if kind == "base":  # the modal constant of z / a_base is known, -G in/g: energy balance
-                env_out["zeta_phase_resonance"] = zeta_at_quadrature(fit) * G / fit.modal_constant
+            # energy balance at the FRF's quadrature where the modal constant is known: -G in/g
+            # for z / a_base, G / mass_lbf in/lbf (1/m) for x / F; none for a voltage
+            known = {"base": G, "force": G / mass_lbf}.get(kind)
+            if known is not None and np.isfinite(fit.f_quad_hz):
+                env_out["zeta_phase_resonance"] = zeta_at_quadrature(fit) * known / fit.modal_constant
         if fit.truncated > 0.01:
             flags.append("frf_truncated")
+        if fit.residual > frf_misfit:
+            flags.append("frf_misfit")
     if np.isfinite(eta) and eta > eta_max:
         flags.append("eta_high")
     if method == "none" or (method == "peak" and "resonance_outside_band" in flags):

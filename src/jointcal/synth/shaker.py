@@ -18,10 +18,12 @@ mass, suspension and electrical damping Bl Bl_e / R included. The joint's nonlin
 remainder r_nl = F_iwan - KT x (and the effects' k3, c2 terms) enters as in
 `jointcal.models.simulate`, whose exact-Iwan kernel integrates this 3-state system.
 
-Truth at a drive level V0 (`rig_truth`): the steady-state amplitude at resonance from
-the equivalent-linear (first-harmonic) coupled FRF, and there the structure's own
-natural frequency and damping (what H1 of response / force shows) and the rig's pole
-(what H1 of response / voltage shows).
+Truth at a drive level V0 (`rig_truth`), from the equivalent-linear (first-harmonic)
+coupled FRF: the structure's own natural frequency and damping (what H1 of response /
+force shows) at the steady-state amplitude at its own phase resonance, and the rig's
+pole (what H1 of response / voltage shows) at the steady-state amplitude at the rig's
+resonance. For a nonlinear joint the two amplitudes differ: the rig's resonance lies
+below the structure's (armature mass), and at the structure's the force drops out.
 """
 from __future__ import annotations
 
@@ -37,7 +39,7 @@ from ..models.iwan import derived
 from ..models.simulate import _substep_maps, fractional_delay, hermite_propagator
 
 __all__ = ["Shaker", "BL_E_PER_BL", "rig_matrices", "simulate_rig", "structure_equivalent", "rig_pole",
-           "steady_amplitude", "rig_truth"]
+           "steady_amplitude", "structure_resonance_amplitude", "rig_truth"]
 
 BL_E_PER_BL = 4.448222 * 0.0254  # V/(in/s) of back-EMF per lbf/A of force constant (= 1 in SI)
 
@@ -225,22 +227,73 @@ def steady_amplitude(model: MinistackModel, shaker: Shaker, volts: float, *, ite
     return float(np.exp(0.5 * (lo + hi)))
 
 
-def rig_truth(model: MinistackModel, shaker: Shaker, volts: float, q_reached: float) -> dict:
+def structure_resonance_amplitude(model: MinistackModel, shaker: Shaker, volts: float, *,
+                                  iterations: int = 60) -> float:
+    """Steady-state amplitude (in) at the STRUCTURE's phase resonance under a voltage amplitude (V).
+
+    Where x / F is in quadrature the structure's equivalent-linear stiffness balances
+    its inertia, w = w_hb(q); there the rig is off its own (mass-loaded) resonance and
+    the force drops out, so the amplitude is smaller than `steady_amplitude`. Solves
+    q = V |x/V(w_hb(q); q)| by bisection in log q.
+    """
+    def amp(q):
+        den, Bl = _rig_poly(model, shaker, q)
+        w = 2 * np.pi * structure_equivalent(model, q)[0]
+        return volts * abs(Bl / np.polyval(den, 1j * w))
+
+    if model.iwan is None:
+        return float(amp(1.0))
+    phimax = float(derived(model.iwan.Fs, model.iwan.KT, model.iwan.chi, model.iwan.beta)[0])
+    lo, hi = np.log(1e-9 * phimax), np.log(1e3 * phimax)
+    for _ in range(iterations):
+        mid = 0.5 * (lo + hi)
+        if amp(np.exp(mid)) > np.exp(mid):
+            lo = mid
+        else:
+            hi = mid
+    return float(np.exp(0.5 * (lo + hi)))
+
+
+def _reached(t: NDArray, f_inst: NDArray, x: NDArray, f: float, zeta: float) -> float:
+    """Largest |x| (in) while the drive is within +-zeta f / 2 of f (Hz), allowing the response's lag.
+
+    The response lags the drive by about 1/(zeta w): the window looks that far past the crossing.
+    """
+    ahead = np.interp(t - 1.0 / (2 * np.pi * f * zeta), t, f_inst)
+    near = np.abs(ahead - f) <= 0.5 * zeta * f
+    return float(np.max(np.abs(x[near]))) if near.any() else float("nan")
+
+
+def rig_truth(model: MinistackModel, shaker: Shaker, volts: float, t: NDArray | None = None,
+              f_inst: NDArray | None = None, x: NDArray | None = None) -> dict:
     """Truth of one rig run at drive amplitude `volts` (V).
+
+    Parameters
+    ----------
+    model, shaker, volts : the rig and the amplifier's voltage amplitude (V).
+    t, f_inst, x : ndarray, optional
+        The simulated sweep: time (s), drive frequency (Hz) and displacement (in), to
+        read the amplitude the sweep actually reached near each resonance.
 
     Returns
     -------
     dict
-        q_ss_in (steady-state amplitude at resonance, in); f_hb_hz, zeta_hb (the
-        structure alone at q_ss: what H1 of response / force shows); f_rig_hz, zeta_rig
-        (the rig's pole at q_ss: what H1 of response / voltage shows); the same four at
-        q_reached_in, the largest amplitude the simulated sweep reached (a fast chirp
+        q_ss_in, f_hb_hz, zeta_hb: the structure alone (what H1 of response / force
+        shows) at the steady-state amplitude at its own phase resonance;
+        q_rig_ss_in, f_rig_hz, zeta_rig: the rig's pole (what H1 of response /
+        voltage shows) at the steady-state amplitude at the rig's resonance; with the
+        sweep, the same at the largest amplitude reached while the drive was within
+        +-zeta f / 2 of that resonance (q_reached_in, f_hb_hz_reached, ... a fast chirp
         never builds the steady state), suffixed _reached.
     """
-    q = steady_amplitude(model, shaker, volts)
-    out = dict(q_ss_in=q, q_reached_in=float(q_reached))
-    for sfx, qq in (("", q), ("_reached", float(q_reached))):
-        f, z = structure_equivalent(model, qq)
-        fr, zr = rig_pole(model, shaker, qq)
-        out.update({f"f_hb_hz{sfx}": f, f"zeta_hb{sfx}": z, f"f_rig_hz{sfx}": fr, f"zeta_rig{sfx}": zr})
+    q_s, q_r = structure_resonance_amplitude(model, shaker, volts), steady_amplitude(model, shaker, volts)
+    f, z = structure_equivalent(model, q_s)
+    fr, zr = rig_pole(model, shaker, q_r)
+    out = dict(q_ss_in=q_s, f_hb_hz=f, zeta_hb=z, q_rig_ss_in=q_r, f_rig_hz=fr, zeta_rig=zr)
+    if x is not None:
+        qs, qr = _reached(t, f_inst, x, f, z), _reached(t, f_inst, x, fr, zr)
+        f2, z2 = structure_equivalent(model, qs)
+        fr2, zr2 = rig_pole(model, shaker, qr)
+        out.update(q_reached_in=qs, f_hb_hz_reached=f2, zeta_hb_reached=z2, q_rig_reached_in=qr,
+                   f_rig_hz_reached=fr2, zeta_rig_reached=zr2)
     return out
