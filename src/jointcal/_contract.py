@@ -70,9 +70,9 @@ def excitation_of(names: Sequence[str], where: object) -> Excitation:
              "keep the one reference channel of the test (base acceleration, force or drive voltage)")
     missing = [c for c in want if c not in names]
     if missing:
-        also = (" (or 'force_lbf' / 'drive_V' for a force- / voltage-driven run)" if missing[0] == REFERENCE["base"]
-                else " (or 'response_accel_m_s2' for a response in m/s^2)" if missing[0] == RESPONSE else "")
-        fail(where, f"column '{missing[0]}'{also} is missing {found}", fix)
+        also = " (or 'force_lbf' / 'drive_V' for a force- / voltage-driven run)" if missing[0] == REFERENCE["base"] else ""
+        si = " (or 'response_accel_m_s2' for a response in m/s^2)" if missing[0] == RESPONSE else ""
+        fail(where, f"column '{missing[0]}'{also} is missing{si} {found}", fix)
     extra = [c for c in names if c not in want]
     if extra:
         fail(where, f"unexpected column(s) {', '.join(extra)} {found}", fix)

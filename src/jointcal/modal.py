@@ -141,16 +141,24 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
     tab, fit = _frf_estimates(record, row, kind, env_out["f_peak_hz"], frf_span)
     f_res, method = env_out["f_res_hz"], env_out["f_res_method"]
     eta = env_out.pop("eta_value")
+    lo, hi = sorted((float(row["f_start_hz"]), float(row["f_stop_hz"])))
+    if fit is not None and ("resonance_outside_band" in flags or not (
+            lo + 0.02 * (hi - lo) < fit.f_n_hz < hi - 0.02 * (hi - lo))):
+        flags.append("resonance_outside_band")  # a peak at the band's edge is no mode: no FRF read-out
+        fit = None
     if fit is not None:
         eta_frf_fit = rate_hz_per_s / (fit.f_n_hz * fit.zeta) ** 2
         eta = eta if np.isfinite(eta) and kind == "base" else eta_frf_fit  # a force's zeta needs the mass
         if kind != "base" or eta > eta_frf or method in ("peak", "none"):
-            f_res, method = (fit.f_quad_hz if np.isfinite(fit.f_quad_hz) else fit.f_n_hz), "frf_fit"
+            # the quadrature of the measured ratio where it belongs to this mode (within the
+            # half-power half-width of the pole; a sensor off the driving point may have none)
+            quad = np.isfinite(fit.f_quad_hz) and abs(fit.f_quad_hz - fit.f_n_hz) <= fit.zeta * fit.f_n_hz
+            f_res, method = (fit.f_quad_hz if quad else fit.f_n_hz), "frf_fit"
             flags = [f for f in flags if f != "no_quadrature"]
             # energy balance at the FRF's quadrature where the modal constant is known: -G in/g
             # for z / a_base, G / mass_lbf in/lbf (1/m) for x / F; none for a voltage
             known = {"base": G, "force": G / mass_lbf}.get(kind)
-            if known is not None and np.isfinite(fit.f_quad_hz):
+            if known is not None and quad:
                 env_out["zeta_phase_resonance"] = zeta_at_quadrature(fit) * known / fit.modal_constant
         if fit.truncated > 0.01:
             flags.append("frf_truncated")
@@ -264,7 +272,7 @@ def _envelope_estimates(env, row, kind, rate_hz_per_s, mass_lbf, eta_max, snr_mi
         zeta_pr = a_ref * G / (2 * omega**2 * q) if method.startswith("quadrature") else np.nan
     zeta_eta = zeta_pr if np.isfinite(zeta_pr) else zeta_hp
     eta = rate_hz_per_s / (f_res * zeta_eta) ** 2 if np.isfinite(zeta_eta) else np.nan
-    if edge:
+    if edge and kind == "base":  # an open-loop reference drops out at resonance: the FRF fit checks instead
         flags.append("resonance_outside_band")
     noise = float(np.median(e["noise_g"]))
     snr = 20 * np.log10(a_resp / noise) if noise > 0 else np.inf

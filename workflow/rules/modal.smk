@@ -11,6 +11,7 @@ rule modal_properties:
     output:
         table=RESULTS / "modal" / "modal_properties.csv",
         scatter=RESULTS / "modal" / "scatter.csv",
+        frf=directory(RESULTS / "modal" / "frf"),
     params:
         version=jointcal.__version__,
         modal=config["modal"],
