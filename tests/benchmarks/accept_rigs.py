@@ -112,12 +112,19 @@ def main(quick: bool = False) -> pd.DataFrame:
                           f"resid {r['residual']:.1e}  [{r['flags']}]", flush=True)
     table = pd.DataFrame(rows)
     print(f"\n{len(table)} runs in {time.time() - t_start:.0f} s")
-    ok = (table["f_err_ss"].abs() < 2e-3) & (table["zeta_err_ss"].abs() < 0.05)
+    # the damping each reference offers: energy balance at the FRF's quadrature for a force with a
+    # known moving mass (modal: mass_lbf), the FRF fit's pole for a voltage (no absolute force)
+    table["zeta_used_err_ss"] = np.where(table["reference"] == "force", table["zeta_pr_err_ss"],
+                                         table["zeta_err_ss"])
+    ok = (table["f_err_ss"].abs() < 2e-3) & (table["zeta_used_err_ss"].abs() < 0.05)
+    print("acceptance (f within 0.2%, damping within 5% of the steady-state truth; force: energy balance, "
+          "voltage: FRF fit):")
     for (name, ref), g in table.groupby(["structure", "reference"], sort=False):
         print(f"{name:10s} {ref:7s}: max |f err| ss {100 * g['f_err_ss'].abs().max():.4f}% "
               f"(reached {100 * g['f_err_reached'].abs().max():.4f}%), max |zeta err| ss "
-              f"{100 * g['zeta_err_ss'].abs().max():.2f}% (reached {100 * g['zeta_err_reached'].abs().max():.2f}%); "
-              f"within 0.2% / 5% of the steady state: {int(ok[g.index].sum())}/{len(g)}")
+              f"{100 * g['zeta_used_err_ss'].abs().max():.2f}% (FRF fit {100 * g['zeta_err_ss'].abs().max():.2f}%); "
+              f"pass {int(ok[g.index].sum())}/{len(g)} at eta "
+              f"{', '.join(f'{e:g}' for e in g.loc[ok[g.index], 'eta_set'])}")
     return table
 
 
