@@ -200,7 +200,10 @@ def test_force_driven_driving_point(tmp_path):
     p = model.iwan
     f, z = harmonic_balance(out["q_in"], p.Fs, p.KT, p.chi, p.beta, model.k, model.m, model.zeta_v)
     assert "level_lbf" in out and "level_g" not in out
-    assert out["f_res_method"] == "frf_fit" and out["flags"] == ""  # force reference: the H1 read-out
+    # force reference: the H1's quadrature; the joint bends the constant-force peak (fit residual
+    # above 2%: flagged), which moves the fitted pole but not the quadrature
+    print(f"\nfit residual {out['frf_residual']:.3f}, f_frf {out['f_frf_hz']:.1f} Hz, f_res {out['f_res_hz']:.1f} Hz")
+    assert out["f_res_method"] == "frf_fit" and out["flags"] == "frf_misfit"
     assert out["f_res_hz"] == pytest.approx(float(f), rel=3e-4)
     assert out["zeta_phase_resonance"] == pytest.approx(float(z), rel=0.02)
     assert env["drive_on"].iloc[-20:].eq(False).all()  # the free decay is not taken for drive

@@ -49,8 +49,9 @@ FLAG_WORDS = {
     "bad_samples": "NaN/inf or clipped samples; frames touching them were left out",
     "no_half_power": "a half-power point lies outside the record",
     "frf_truncated": "the response had not died out at the record's end; the whole-record FRF leaks",
-    "frf_misfit": "the single-mode fit leaves more than frf_misfit of the FRF's peak unexplained (a nonlinear "
-                  "transient, overlapping modes or noise): the FRF read-out is doubtful",
+    "frf_misfit": "the FRF's peak is not one linear mode (fit residual above frf_misfit: a nonlinear "
+                  "structure's bent peak, a transient, overlapping modes or noise); zeta_frf and f_frf_hz are "
+                  "doubtful, a quadrature read-out less so",
     "unusable": "no resonance could be estimated from this run",
 }
 
