@@ -25,13 +25,18 @@ What a lab's FRF software does with a swept-sine or chirp record:
 
 For a nonlinear structure (a bolted joint) the H1 of a sweep is the equivalent FRF at
 that drive level: each line is the response to the drive at that frequency at the
-amplitude the structure had when the sweep crossed it. Near the peak of a slow sweep
-the fitted w_n is the quadrature frequency at the peak amplitude, i.e. the
-equivalent-linear (harmonic-balance) natural frequency at the run's level; a fast chirp
-never builds the steady-state amplitude, so it shows the structure at a smaller one.
+amplitude the structure had when the sweep crossed it, so a softening joint bends the
+peak. Where physics fixes the modal constant's phase (base and force references) the
+quadrature of the measured ratio is read: the phase resonance at the amplitude the peak
+had, i.e. the equivalent-linear (harmonic-balance) frequency at the run's level for a
+slow sweep (measured within 0.2% on the Table 3.2 joint up to eta ~5). The fitted pole
+and damping of a bent peak are not that (off by up to ~1% and tens of % on that joint;
+the fit residual shows it, flag 'frf_misfit' in `jointcal.modal`); a voltage reference
+has only the pole. A fast chirp never builds the steady-state amplitude, so it shows the
+structure at a smaller one.
 
 Reference kinds (`jointcal._contract.REFERENCE`): base acceleration (g; the ratio is
-the relative displacement z over the base acceleration, whose modal constant is -m/m),
+the relative displacement z over the base acceleration, modal constant -G in/g),
 force (lbf; receptance x/F) and amplifier voltage (V; x/V is the rig's FRF, the shaker
 included: only its phase and ratios carry information, no damping can be taken from an
 absolute force).

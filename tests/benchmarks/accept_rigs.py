@@ -32,7 +32,7 @@ import pandas as pd
 from jointcal.io import read_manifest, read_run
 from jointcal.modal import measure_run
 from jointcal.models import G
-from jointcal.synth import generate, load_spec
+from jointcal.synth import generate
 from jointcal.synth.campaign import _model
 from jointcal.synth.shaker import Shaker, rig_truth, steady_amplitude
 
