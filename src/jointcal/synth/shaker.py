@@ -182,76 +182,100 @@ def structure_equivalent(model: MinistackModel, q: float) -> tuple[float, float]
     return float(f), float(z)
 
 
-def _rig_poly(model: MinistackModel, shaker: Shaker, q: float):
-    """Characteristic polynomial (in s) of the equivalent-linear rig at amplitude q."""
+def _structure_terms(model: MinistackModel, q: float) -> tuple[float, float, float]:
+    """The structure's first-harmonic dynamic stiffness at amplitude q (in).
+
+    Returns k_df (in-phase stiffness, lbf/in), c (the dashpot, lbf s/in) and h (the
+    joint's hysteretic loss stiffness D(q) / (pi q^2), lbf/in: its energy per cycle does
+    not depend on frequency), so S(w) = k_df - m w^2 + i (w c + h).
+    """
+    ks, c, m = _structure(model)
     f, z = structure_equivalent(model, q)
     w = 2 * np.pi * f
-    m = model.m
-    M, K, C = m + shaker.m_a, m * w**2 + shaker.k_s, 2 * z * m * w + shaker.c_s
-    Bl, Ble, L, R = shaker.bl_lbf_per_A, shaker.bl_lbf_per_A * BL_E_PER_BL, shaker.coil_mH * 1e-3, shaker.coil_ohm
+    k_df = m * w**2
+    w0 = np.sqrt(ks / m)
+    h = 0.0 if model.iwan is None else 2.0 * k_df * (z - model.zeta_v * w0 / w)  # HB zeta less the dashpot's
+    return k_df, c, h
+
+
+def _electrical(shaker: Shaker):
+    return (shaker.bl_lbf_per_A, shaker.bl_lbf_per_A * BL_E_PER_BL, shaker.coil_mH * 1e-3, shaker.coil_ohm)
+
+
+def _x_over_v(model: MinistackModel, shaker: Shaker, q: float, w: NDArray) -> NDArray:
+    """The equivalent-linear rig's FRF x / V (in/V) at amplitude q and frequencies w (rad/s)."""
+    k_df, c, h = _structure_terms(model, q)
+    Bl, Ble, L, R = _electrical(shaker)
+    mech = k_df + shaker.k_s - (model.m + shaker.m_a) * w**2 + 1j * (w * (c + shaker.c_s) + h)
+    return Bl / ((R + 1j * w * L) * mech + 1j * w * Bl * Ble)
+
+
+def _rig_poly(model: MinistackModel, shaker: Shaker, q: float, w_eval: float | None = None):
+    """Characteristic polynomial (in s) of the equivalent-linear rig at amplitude q.
+
+    The joint's hysteretic loss h enters as the viscous h / w_eval (exact at w_eval,
+    default the structure's own frequency; `rig_pole` iterates it to the pole's).
+    """
+    k_df, c, h = _structure_terms(model, q)
+    w_eval = np.sqrt(k_df / model.m) if w_eval is None else w_eval
+    M, K, C = model.m + shaker.m_a, k_df + shaker.k_s, c + h / w_eval + shaker.c_s
+    Bl, Ble, L, R = _electrical(shaker)
     return np.polymul([L, R], [M, C, K]) + np.array([0.0, 0.0, Bl * Ble, 0.0]), Bl
 
 
 def rig_pole(model: MinistackModel, shaker: Shaker, q: float) -> tuple[float, float]:
-    """The rig's structural pole at amplitude q: |lambda| / 2 pi (Hz) and -Re(lambda) / |lambda|."""
-    den, _ = _rig_poly(model, shaker, q)
-    r = np.roots(den)
-    r = r[np.imag(r) > 0]
-    f0 = structure_equivalent(model, q)[0]
-    lam = r[np.argmin(np.abs(np.abs(r) - 2 * np.pi * f0))]
+    """The rig's structural pole at amplitude q: |lambda| / 2 pi (Hz) and -Re(lambda) / |lambda|.
+
+    The joint's hysteretic loss is taken as the equivalent viscous damping at the
+    pole's own frequency (a fixed point, three iterations: converged to < 1e-9).
+    """
+    w = 2 * np.pi * structure_equivalent(model, q)[0]
+    for _ in range(4):
+        r = np.roots(_rig_poly(model, shaker, q, w)[0])
+        r = r[np.imag(r) > 0]
+        lam = r[np.argmin(np.abs(np.abs(r) - w))]
+        w = abs(lam)
     return float(abs(lam) / (2 * np.pi)), float(-lam.real / abs(lam))
 
 
-def steady_amplitude(model: MinistackModel, shaker: Shaker, volts: float, *, iterations: int = 60) -> float:
-    """Steady-state displacement amplitude (in) at the rig's resonance under a voltage amplitude (V).
-
-    Solves q = V max_w |x/V(w; q)| by bisection in log q, with the joint's
-    equivalent-linear stiffness and damping at q (first harmonic).
-    """
-    def peak(q):
-        den, Bl = _rig_poly(model, shaker, q)
-        f, _ = structure_equivalent(model, q)
-        w = 2 * np.pi * f * np.linspace(0.7, 1.3, 4001)
-        return volts * np.max(np.abs(Bl / np.polyval(den, 1j * w)))
-
-    if model.iwan is None:
-        return float(peak(1.0))
-    phimax = float(derived(model.iwan.Fs, model.iwan.KT, model.iwan.chi, model.iwan.beta)[0])
-    lo, hi = np.log(1e-9 * phimax), np.log(1e3 * phimax)
-    for _ in range(iterations):
-        mid = 0.5 * (lo + hi)
-        if peak(np.exp(mid)) > np.exp(mid):
-            lo = mid
-        else:
-            hi = mid
-    return float(np.exp(0.5 * (lo + hi)))
-
-
-def structure_resonance_amplitude(model: MinistackModel, shaker: Shaker, volts: float, *,
-                                  iterations: int = 60) -> float:
-    """Steady-state amplitude (in) at the STRUCTURE's phase resonance under a voltage amplitude (V).
-
-    Where x / F is in quadrature the structure's equivalent-linear stiffness balances
-    its inertia, w = w_hb(q); there the rig is off its own (mass-loaded) resonance and
-    the force drops out, so the amplitude is smaller than `steady_amplitude`. Solves
-    q = V |x/V(w_hb(q); q)| by bisection in log q.
-    """
-    def amp(q):
-        den, Bl = _rig_poly(model, shaker, q)
-        w = 2 * np.pi * structure_equivalent(model, q)[0]
-        return volts * abs(Bl / np.polyval(den, 1j * w))
-
+def _self_consistent(model: MinistackModel, amp, iterations: int = 60) -> float:
+    """The amplitude q (in) with amp(q) = q, by bisection in log q (a single root for a softening joint)."""
     if model.iwan is None:
         return float(amp(1.0))
     phimax = float(derived(model.iwan.Fs, model.iwan.KT, model.iwan.chi, model.iwan.beta)[0])
     lo, hi = np.log(1e-9 * phimax), np.log(1e3 * phimax)
     for _ in range(iterations):
         mid = 0.5 * (lo + hi)
-        if amp(np.exp(mid)) > np.exp(mid):
-            lo = mid
-        else:
-            hi = mid
+        lo, hi = (mid, hi) if amp(np.exp(mid)) > np.exp(mid) else (lo, mid)
     return float(np.exp(0.5 * (lo + hi)))
+
+
+def steady_amplitude(model: MinistackModel, shaker: Shaker, volts: float) -> float:
+    """Steady-state displacement amplitude (in) at the rig's resonance under a voltage amplitude (V).
+
+    Solves q = V max_w |x/V(w; q)|, with the joint's first-harmonic stiffness and
+    hysteretic loss at q.
+    """
+    def peak(q):
+        w = 2 * np.pi * structure_equivalent(model, q)[0] * np.linspace(0.7, 1.3, 4001)
+        return volts * np.max(np.abs(_x_over_v(model, shaker, q, w)))
+
+    return _self_consistent(model, peak)
+
+
+def structure_resonance_amplitude(model: MinistackModel, shaker: Shaker, volts: float) -> float:
+    """Steady-state amplitude (in) at the STRUCTURE's phase resonance under a voltage amplitude (V).
+
+    Where x / F is in quadrature the structure's equivalent-linear stiffness balances
+    its inertia, w = w_hb(q); there the rig is off its own (mass-loaded) resonance and
+    the force drops out, so the amplitude is smaller than `steady_amplitude`. Solves
+    q = V |x/V(w_hb(q); q)|.
+    """
+    def amp(q):
+        w = np.array([2 * np.pi * structure_equivalent(model, q)[0]])
+        return volts * float(np.abs(_x_over_v(model, shaker, q, w))[0])
+
+    return _self_consistent(model, amp)
 
 
 def _reached(t: NDArray, f_inst: NDArray, x: NDArray, f: float, zeta: float) -> float:
