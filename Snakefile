@@ -2,7 +2,7 @@
 # Stages, in the order data flows (workflow/rules/<stage>.smk; logic in src/jointcal/):
 #   ingest     validate the campaign (manifest + run files) -> <results>/ingest/runs.csv
 #   envelopes  drive ridge + complex amplitudes per run     -> <results>/envelopes/<run_id>.csv
-#   modal      resonance, damping, scatter, figures          -> <results>/modal/modal_properties.csv
+#   modal      resonance, damping, scatter, figures, FRFs    -> <results>/modal/modal_properties.csv, frf/
 #   calibrate  GA (DEAP) on eq. 3.9 per assembly + polish     -> <results>/calibration/<assembly>/ga_best.json
 #   posterior  emcee around the optimum, Table 3.2, Fig. 3.8  -> <results>/posterior/<assembly>/summary.csv
 #

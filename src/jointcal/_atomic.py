@@ -148,10 +148,11 @@ def write_run(path: str | os.PathLike[str], time_s: ArrayLike, base_or_force: Ar
     time_s : array_like, shape (n,)
         Sample times (s).
     base_or_force : array_like, shape (n,)
-        Base acceleration (g) for ``kind='base'`` or force (lbf) for ``kind='force'``.
+        Base acceleration (g) for ``kind='base'``, force (lbf) for ``kind='force'`` or
+        drive voltage (V) for ``kind='voltage'``.
     response_g : array_like, shape (n,)
         Response acceleration (g).
-    kind : {'base', 'force'}, optional
+    kind : {'base', 'force', 'voltage'}, optional
         Excitation kind, which names the reference column.
 
     Returns
@@ -160,7 +161,7 @@ def write_run(path: str | os.PathLike[str], time_s: ArrayLike, base_or_force: Ar
         The written file.
     """
     if kind not in REFERENCE:
-        raise ValueError(f"kind must be 'base' or 'force', got {kind!r}")
+        raise ValueError(f"kind must be one of {', '.join(REFERENCE)}, got {kind!r}")
     cols = {TIME: time_s, REFERENCE[kind]: base_or_force, RESPONSE: response_g}
     cols = {k: np.asarray(v, dtype=np.float64) for k, v in cols.items()}
     if len({v.shape for v in cols.values()}) != 1 or cols[TIME].ndim != 1:

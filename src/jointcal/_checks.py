@@ -252,7 +252,7 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
         raise ValueError(f"on_data_problem must be 'error' or 'flag', got {on_data_problem!r}")
     run = repr(row["run_id"])
     kind = excitation_of([str(c) for c in df.columns], path)
-    want = "force" if LEVEL["force"] in row else "base"
+    want = next((k for k, c in LEVEL.items() if c in row), "base")
     if kind != want:
         fail(path, f"it holds {REFERENCE[kind]} but the manifest gives {LEVEL[want]} for run {run}",
              f"export {REFERENCE[want]} or correct the manifest's level column")

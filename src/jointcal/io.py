@@ -2,8 +2,10 @@
 
 A campaign folder holds ``manifest.csv`` (one row per run) and one record per run
 (``.csv``, ``.csv.gz`` or MATLAB ``.mat``) with the columns ``time_s`` (s),
-``base_accel_g`` (g) or, for force-driven tests, ``force_lbf`` (lbf), and
-``response_accel_g`` (g); 1 g = 386.089 in/s^2. ``raw_data/README.md`` states the
+``base_accel_g`` (g) or, for force-driven tests, ``force_lbf`` (lbf), or, for a
+shaker driven open-loop, ``drive_V`` (amplifier voltage, V), and ``response_accel_g``
+(g) or ``response_accel_m_s2`` (m/s^2, converted to g on read); 1 g = 386.089 in/s^2
+= 9.80665 m/s^2. ``raw_data/README.md`` states the
 contract for people; every violation raises `CampaignError` with one sentence that
 names the file, the problem and the fix. File I/O of the package lives here (the
 checks and writers are in private helper modules and re-exported).
@@ -24,7 +26,7 @@ from numpy.typing import NDArray
 from jointcal._atomic import write_bytes_atomic, write_csv_atomic, write_json_atomic, write_run
 from jointcal._checks import validate_run
 from jointcal._contract import (
-    LEVEL, POSITIVE, REFERENCE, RESPONSE, TEXT, TIME, CampaignError, CampaignWarning,
+    G_SI, LEVEL, POSITIVE, REFERENCE, RESPONSE, RESPONSE_SI, TEXT, TIME, CampaignError, CampaignWarning,
     OnDataProblem, excitation_of, fail,
 )
 
@@ -43,7 +45,8 @@ def read_manifest(path: str | os.PathLike[str]) -> pd.DataFrame:
     path : path-like
         The manifest file. Columns: ``run_id``, ``assembly``, ``sequence`` (order of
         the run within its assembly, integer >= 1), ``level_g`` (base acceleration
-        amplitude, g) or ``level_lbf`` (force amplitude, lbf), ``direction``
+        amplitude, g), ``level_lbf`` (force amplitude, lbf) or ``level_V`` (drive
+        voltage amplitude, V), ``direction``
         (``up``/``down``), ``f_start_hz``, ``f_stop_hz`` (Hz),
         ``sweep_rate_hz_per_s`` (Hz/s), ``sample_rate_hz`` (Hz) and ``file`` (relative
         to the manifest's folder). Extra columns are kept.
@@ -73,8 +76,8 @@ def read_manifest(path: str | os.PathLike[str]) -> pd.DataFrame:
     levels = [c for c in LEVEL.values() if c in raw.columns]
     if len(levels) != 1:
         found = " and ".join(levels) or "neither"
-        fail(path, f"it needs exactly one of the columns level_g, level_lbf (found {found})",
-             "give level_g for base-driven or level_lbf for force-driven campaigns")
+        fail(path, f"it needs exactly one of the columns {', '.join(LEVEL.values())} (found {found})",
+             "give level_g for base-driven, level_lbf for force-driven or level_V for voltage-driven campaigns")
     need = ["run_id", "assembly", "sequence", levels[0], "direction", *POSITIVE, "file"]
     missing = [c for c in need if c not in raw.columns]
     if missing:
@@ -172,15 +175,18 @@ def read_run(path: str | os.PathLike[str]) -> pd.DataFrame:
     ----------
     path : path-like
         CSV with the header ``time_s,base_accel_g,response_accel_g`` (force-driven:
-        ``time_s,force_lbf,response_accel_g``), gzip-compressed CSV, or a MATLAB v5/v7
+        ``time_s,force_lbf,response_accel_g``; voltage-driven:
+        ``time_s,drive_V,response_accel_g``; a response in m/s^2 is declared by naming
+        its column ``response_accel_m_s2``), gzip-compressed CSV, or a MATLAB v5/v7
         file holding variables of those names as row or column vectors (other
         variables are ignored).
 
     Returns
     -------
     pandas.DataFrame
-        Columns ``time_s`` (s), ``base_accel_g`` (g) or ``force_lbf`` (lbf),
-        ``response_accel_g`` (g), all float64, shape (n, 3). Empty cells become NaN.
+        Columns ``time_s`` (s), ``base_accel_g`` (g), ``force_lbf`` (lbf) or
+        ``drive_V`` (V), and ``response_accel_g`` (g; converted from m/s^2 when so
+        declared), all float64, shape (n, 3). Empty cells become NaN.
 
     Raises
     ------
@@ -208,7 +214,7 @@ def _read_csv(path: Path) -> dict[str, NDArray[np.float64]]:
     df.columns = [str(c).strip() for c in df.columns]
     kind = excitation_of(list(df.columns), path)
     out = {}
-    for col in (TIME, REFERENCE[kind], RESPONSE):
+    for col in (TIME, REFERENCE[kind], _response_name(df.columns)):
         values = pd.to_numeric(df[col], errors="coerce")
         bad = values.isna() & df[col].notna()
         if bad.any():
@@ -216,7 +222,19 @@ def _read_csv(path: Path) -> dict[str, NDArray[np.float64]]:
             fail(path, f"column '{col}' has the non-numeric value {df[col].iloc[i]!r} on line {i + 2}",
                  "export plain numbers")
         out[col] = values.to_numpy(np.float64)
-    return out
+    return _in_g(out)
+
+
+def _response_name(names) -> str:
+    """The response column present: ``response_accel_g`` or ``response_accel_m_s2``."""
+    return RESPONSE_SI if RESPONSE_SI in names and RESPONSE not in names else RESPONSE
+
+
+def _in_g(cols: dict[str, NDArray[np.float64]]) -> dict[str, NDArray[np.float64]]:
+    """Rename a response declared in m/s^2 to ``response_accel_g``, converted to g."""
+    if RESPONSE_SI in cols:
+        return {(RESPONSE if k == RESPONSE_SI else k): (v / G_SI if k == RESPONSE_SI else v) for k, v in cols.items()}
+    return cols
 
 
 def _read_mat(path: Path) -> dict[str, NDArray[np.float64]]:
@@ -227,9 +245,9 @@ def _read_mat(path: Path) -> dict[str, NDArray[np.float64]]:
     except (OSError, ValueError, TypeError) as exc:
         fail(path, f"cannot be read as a MATLAB file ({exc})", "save it with MATLAB's save(..., '-v7')")
     names = [k for k in mat if not k.startswith("__")]
-    kind = excitation_of([n for n in names if n in (TIME, RESPONSE, *REFERENCE.values())], path)
+    kind = excitation_of([n for n in names if n in (TIME, RESPONSE, RESPONSE_SI, *REFERENCE.values())], path)
     out = {}
-    for var in (TIME, REFERENCE[kind], RESPONSE):
+    for var in (TIME, REFERENCE[kind], _response_name(names)):
         a = np.asarray(mat[var])
         if a.ndim > 2 or (a.ndim == 2 and min(a.shape) != 1) or not np.issubdtype(a.dtype, np.number):
             fail(path, f"variable '{var}' is a {a.dtype} array of shape {a.shape}, not a numeric vector",
@@ -238,7 +256,7 @@ def _read_mat(path: Path) -> dict[str, NDArray[np.float64]]:
     lengths = {len(v) for v in out.values()}
     if len(lengths) != 1:
         fail(path, f"variables have different lengths {sorted(lengths)}", "save the three channels with one length")
-    return out
+    return _in_g(out)
 
 
 def ingest_campaign(campaign_dir: str | os.PathLike[str], *,

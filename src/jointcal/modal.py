@@ -10,11 +10,18 @@ From a run's envelopes (`jointcal.signal.envelopes`):
   (eta <= eta_max) tau_g = 1/(zeta omega), the phase relaxation time at fixed amplitude,
   with the phase-resonance zeta (method 'quadrature'); beyond, tau_g = |d phi/d omega|
   from the measured phase slope (method 'quadrature_slope'); beyond eta_frf the
-  whole-record FRF's quadrature (method 'frf').
+  whole-record FRF's single-mode fit (method 'frf_fit', `jointcal.frf`).
+* force- and amplifier-voltage-driven runs (an open-loop shaker: the force drops out
+  at resonance, the voltage is not the force, chirps are often fast): the resonance
+  and damping of the whole-record H1's single-mode fit ('frf_fit'), as a lab's FRF
+  software reads them; for a nonlinear structure the equivalent FRF at that drive
+  level. Reported for every run with a record (f_frf_hz, zeta_frf, frf_residual), so
+  the envelope and FRF read-outs can be compared.
 * the peak of the response envelope (the paper's resonance read-out);
 * damping by half-power bandwidth of the response envelope (the paper's estimate),
   and by phase-resonance energy balance at quadrature, zeta = |a_base| / (2 omega^2 q)
-  (one amplitude, no bandwidth); force-driven: zeta = |F| / (2 m |a|).
+  (one amplitude, no bandwidth); force-driven: zeta = |F| / (2 m |a|) (needs the
+  moving mass); voltage-driven: none (no absolute force), zeta_frf only.
 * group_delay_s: the lag tau_g used for the correction (s);
 * quality flags; a flagged value is kept and marked, never dropped. 'unusable' marks a
   row the calibration must not use.
@@ -24,10 +31,15 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from ._contract import LEVEL, REFERENCE, RESPONSE
+from .frf import record_frf, zeta_at_quadrature
 from .models import G
 from .signal import envelopes
 
-__all__ = ["modal_properties", "measure_run", "scatter", "FLAG_WORDS"]
+__all__ = ["modal_properties", "measure_run", "scatter", "FLAG_WORDS", "ENVELOPE_COLUMNS"]
+
+ENVELOPE_COLUMNS = ("time_s", "f_drive_hz", "ref_re", "ref_im", "resp_re", "resp_im", "z_re", "z_im", "h2_amp_g",
+                    "h3_amp_g", "noise_g", "drive_on", "bad")
 
 FLAG_WORDS = {
     "eta_high": "sweep too fast for quasi-steady envelopes (eta > eta_max)",
@@ -36,6 +48,10 @@ FLAG_WORDS = {
     "low_snr": "response at resonance less than snr_min above the noise floor",
     "bad_samples": "NaN/inf or clipped samples; frames touching them were left out",
     "no_half_power": "a half-power point lies outside the record",
+    "frf_truncated": "the response had not died out at the record's end; the whole-record FRF leaks",
+    "frf_misfit": "the FRF's peak is not one linear mode (fit residual above frf_misfit: a nonlinear "
+                  "structure's bent peak, a transient, overlapping modes or noise); zeta_frf and f_frf_hz are "
+                  "doubtful, a quadrature read-out less so",
     "unusable": "no resonance could be estimated from this run",
 }
 
@@ -65,38 +81,132 @@ def _half_power(f: np.ndarray, a: np.ndarray, ip: int):
     return min(lo, hi), max(lo, hi)
 
 
+def _kind(row: dict, record: pd.DataFrame | None) -> str:
+    """Reference kind of a run ('base', 'force', 'voltage'): from the record's columns, else the level column."""
+    cols = record.columns if record is not None else []
+    kinds = [k for k, c in REFERENCE.items() if c in cols] or [k for k, c in LEVEL.items() if c in row]
+    return kinds[0] if kinds else "base"
+
+
 def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass_lbf: float = 2.65,
-                     eta_max: float = 0.5, eta_frf: float = 4.0, snr_min_db: float = 20.0,
-                     record: pd.DataFrame | None = None) -> dict:
+                     eta_max: float = 0.5, eta_frf: float = 4.0, snr_min_db: float = 20.0, frf_span: float = 2.0,
+                     frf_misfit: float = 0.02,
+                     record: pd.DataFrame | None = None, with_frf: bool = False):
     """Resonance, damping, amplitudes and flags of one run (one row of modal_properties.csv).
 
     Parameters
     ----------
     env : DataFrame
-        The run's envelopes.
+        The run's envelopes (may be empty when the envelope stage could not process the
+        run, e.g. a chirp too short for its window: the FRF path still applies).
     row : mapping
         Its manifest row.
     rate_hz_per_s : float
         Measured sweep rate (Hz/s), from the envelopes' ridge; the local rate at the
         crossing (slope of the tracked drive frequency) is used where it is sound.
     mass_lbf : float
-        Weight of the moving mass (lbf), used only for force-driven damping.
+        Weight of the moving mass (lbf), used only for force-driven phase-resonance damping.
+    eta_max, eta_frf : float
+        Sweep-rate parameter beyond which a base-driven run's envelopes are corrected by
+        the measured phase slope (eta_max) and replaced by the FRF fit (eta_frf).
+    frf_span : float
+        Half-width of the FRF fit band in half-power bandwidths (`jointcal.frf.fit_mode`).
+    frf_misfit : float
+        Relative RMS residual of the FRF fit above which the run is flagged 'frf_misfit'
+        (measured on synthetic rigs, tests/benchmarks/accept_rigs.py: a linear mode with
+        0.3% noise fits to 0.07-0.14%, a lightly nonlinear 100 Hz jointed beam to
+        0.4-1.8%, the Table 3.2 joint's bent peaks to 1.1-9%, its eta-20 chirps'
+        transients to 9-63%).
     record : DataFrame, optional
-        The raw record, for the whole-record FRF when the sweep is too fast.
+        The raw record, for the whole-record FRF (`jointcal.frf`).
+    with_frf : bool
+        Also return the FRF table (H1, H2, coherence, fitted displacement ratio).
+
+    Returns
+    -------
+    props : dict
+        One row of modal_properties.csv. ``f_res_hz`` by ``f_res_method``:
+        'quadrature' / 'quadrature_slope' (base- and force-driven envelopes, lag-corrected;
+        see the module docstring), 'frf_fit' (the whole-record H1's single-mode fit:
+        force- and voltage-driven runs, and base-driven runs beyond eta_frf), 'peak'
+        (envelope peak, no quadrature and no FRF). Always alongside: ``f_peak_hz``
+        (envelope peak), ``f_frf_hz`` and ``zeta_frf`` (the FRF fit's pole: for a nonlinear
+        structure the equivalent FRF at that drive level, see `jointcal.frf`),
+        ``f_frf_quad_hz`` (the FRF's quadrature, the 'frf_fit' read-out of f_res_hz),
+        ``frf_residual`` (its relative RMS misfit) and ``frf_truncated``.
+    frf : DataFrame (only with ``with_frf``)
+        `jointcal.frf.record_frf`'s table, or an empty one.
     """
-    force = "force_lbf" in (record.columns if record is not None else []) or "level_lbf" in row
+    kind = _kind(row, record)
+    out = {k: row[k] for k in ("run_id", "assembly", "sequence", "direction") if k in row}
+    out[LEVEL[kind]] = row.get(LEVEL[kind], np.nan)
+    env_out, flags = _envelope_estimates(env, row, kind, rate_hz_per_s, mass_lbf, eta_max, snr_min_db)
+    tab, fit = _frf_estimates(record, row, kind, env_out["f_peak_hz"], frf_span)
+    f_res, method = env_out["f_res_hz"], env_out["f_res_method"]
+    eta = env_out.pop("eta_value")
+    lo, hi = sorted((float(row["f_start_hz"]), float(row["f_stop_hz"])))
+    if fit is not None and ("resonance_outside_band" in flags or not (
+            lo + 0.02 * (hi - lo) < fit.f_n_hz < hi - 0.02 * (hi - lo))):
+        flags.append("resonance_outside_band")  # a peak at the band's edge is no mode: no FRF read-out
+        fit = None
+    if fit is not None:
+        eta_frf_fit = rate_hz_per_s / (fit.f_n_hz * fit.zeta) ** 2
+        eta = eta if np.isfinite(eta) and kind == "base" else eta_frf_fit  # a force's zeta needs the mass
+        if kind != "base" or eta > eta_frf or method in ("peak", "none"):
+            # the quadrature of the measured ratio where it belongs to this mode (within the
+            # half-power half-width of the pole; a sensor off the driving point may have none)
+            quad = np.isfinite(fit.f_quad_hz) and abs(fit.f_quad_hz - fit.f_n_hz) <= fit.zeta * fit.f_n_hz
+            f_res, method = (fit.f_quad_hz if quad else fit.f_n_hz), "frf_fit"
+            flags = [f for f in flags if f != "no_quadrature"]
+            # energy balance at the FRF's quadrature where the modal constant is known: -G in/g
+            # for z / a_base, G / mass_lbf in/lbf (1/m) for x / F; none for a voltage
+            known = {"base": G, "force": G / mass_lbf}.get(kind)
+            if known is not None and quad:
+                env_out["zeta_phase_resonance"] = zeta_at_quadrature(fit) * known / fit.modal_constant
+            if fit.truncated > 0.01:  # flags of the value used (the FRF columns are always reported)
+                flags.append("frf_truncated")
+            if fit.residual > frf_misfit:
+                flags.append("frf_misfit")
+    if np.isfinite(eta) and eta > eta_max:
+        flags.append("eta_high")
+    if method == "none" or (method == "peak" and "resonance_outside_band" in flags):
+        flags.append("unusable")
+    out.update(env_out, f_res_hz=float(f_res), f_res_method=method, eta=float(eta),
+               f_frf_hz=fit.f_n_hz if fit else np.nan, f_frf_quad_hz=fit.f_quad_hz if fit else np.nan,
+               zeta_frf=fit.zeta if fit else np.nan,
+               frf_residual=fit.residual if fit else np.nan, frf_truncated=fit.truncated if fit else np.nan,
+               flags=";".join(dict.fromkeys(flags)))
+    return (out, tab) if with_frf else out
+
+
+def _frf_estimates(record, row, kind, f_guess, span):
+    """The whole-record FRF and its single-mode fit; (empty table, None) without a usable record."""
+    if record is None or len(record) < 64:
+        return pd.DataFrame(), None
+    lo, hi = sorted((float(row["f_start_hz"]), float(row["f_stop_hz"])))
+    try:
+        return record_frf(record[REFERENCE[kind]].to_numpy(float), record[RESPONSE].to_numpy(float),
+                          float(row["sample_rate_hz"]), kind, (lo, hi), span=span,
+                          f_guess=f_guess if np.isfinite(f_guess) else None)
+    except (ValueError, np.linalg.LinAlgError):
+        return pd.DataFrame(), None
+
+
+def _envelope_estimates(env, row, kind, rate_hz_per_s, mass_lbf, eta_max, snr_min_db):
+    """Resonance and damping from the envelopes (quadrature, lag-corrected; or the peak)."""
+    force = kind == "force"
     flags: list[str] = []
-    use = env["drive_on"].to_numpy() & ~env["bad"].to_numpy()
+    nan = dict(f_res_hz=np.nan, f_crossing_hz=np.nan, f_peak_hz=np.nan, zeta_half_power=np.nan,
+               zeta_phase_resonance=np.nan, q_in=np.nan, response_g=np.nan, base_g=np.nan, eta_value=np.nan,
+               group_delay_s=np.nan, snr_db=np.nan, h2_ratio=np.nan, h3_ratio=np.nan, f_res_method="none")
+    if len(env) == 0:
+        return nan, flags
+    use = env["drive_on"].to_numpy(bool) & ~env["bad"].to_numpy(bool)
     if env["bad"].any():
         flags.append("bad_samples")
     e = env[use]
-    out = {k: row[k] for k in ("run_id", "assembly", "sequence", "direction") if k in row}
-    out["level_lbf" if force else "level_g"] = row.get("level_lbf" if force else "level_g", np.nan)
-    nan = dict(f_res_hz=np.nan, f_crossing_hz=np.nan, f_peak_hz=np.nan, zeta_half_power=np.nan,
-               zeta_phase_resonance=np.nan, q_in=np.nan, response_g=np.nan, base_g=np.nan, eta=np.nan,
-               group_delay_s=np.nan, snr_db=np.nan, h2_ratio=np.nan, h3_ratio=np.nan, f_res_method="none")
     if len(e) < 8:
-        return {**out, **nan, "flags": ";".join(flags + ["unusable"])}
+        return nan, flags
     f = e["f_drive_hz"].to_numpy()
     Rf = (e["ref_re"] + 1j * e["ref_im"]).to_numpy()
     R = (e["resp_re"] + 1j * e["resp_im"]).to_numpy()
@@ -124,7 +234,8 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
     zeta_hp = (hi - lo) / (2 * f_peak) if np.isfinite(lo + hi) else np.nan
     if not np.isfinite(zeta_hp):
         flags.append("no_half_power")
-    cands = _crossing(ph, np.pi / 2)
+    # a drive voltage is not the force: its phase to the response has no quadrature meaning
+    cands = _crossing(ph, np.pi / 2) if kind != "voltage" else np.zeros(0, int)
     if cands.size:
         i = cands[np.argmin(np.abs(f[cands] - f_peak))]
         w = (np.pi / 2 - ph[i]) / (ph[i + 1] - ph[i]) if ph[i + 1] != ph[i] else 0.0
@@ -151,7 +262,8 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
             method = "quadrature_slope"
         f_res = f_x - sgn * rate * tau_g
     else:
-        flags.append("no_quadrature")
+        if kind != "voltage":
+            flags.append("no_quadrature")
         f_x, t_x = f_peak, np.nan
         q, a_resp, a_ref = float(np.abs(Z[ip])), float(np.abs(R[ip])), float(np.abs(Rf[ip]))
         f_res, method = f_peak, "peak"
@@ -163,56 +275,20 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
         zeta_pr = a_ref * G / (2 * omega**2 * q) if method.startswith("quadrature") else np.nan
     zeta_eta = zeta_pr if np.isfinite(zeta_pr) else zeta_hp
     eta = rate_hz_per_s / (f_res * zeta_eta) ** 2 if np.isfinite(zeta_eta) else np.nan
-    if np.isfinite(eta) and eta > eta_frf and record is not None and method.startswith("quadrature") and not force:
-        f_frf = _frf_quadrature(record, row, f_x)
-        if np.isfinite(f_frf):
-            f_res, method = f_frf, "frf"
-    if np.isfinite(eta) and eta > eta_max:
-        flags.append("eta_high")
-    if edge:
+    if edge and kind == "base":  # an open-loop reference drops out at resonance: the FRF fit checks instead
         flags.append("resonance_outside_band")
     noise = float(np.median(e["noise_g"]))
     snr = 20 * np.log10(a_resp / noise) if noise > 0 else np.inf
     if snr < snr_min_db:
         flags.append("low_snr")
-    if method == "peak" and edge:
-        flags.append("unusable")
-    out.update(f_res_hz=float(f_res), f_crossing_hz=float(f_x), f_peak_hz=float(f_peak),
+    out = dict(f_res_hz=float(f_res), f_crossing_hz=float(f_x), f_peak_hz=float(f_peak),
                zeta_half_power=float(zeta_hp), zeta_phase_resonance=float(zeta_pr), q_in=float(q),
-               response_g=float(a_resp), base_g=float(a_ref) if not force else np.nan, eta=float(eta),
+               response_g=float(a_resp), base_g=float(a_ref) if kind == "base" else np.nan, eta_value=float(eta),
                group_delay_s=float(tau_g), snr_db=float(snr), h2_ratio=float(e["h2_amp_g"].iloc[ip] / abs(R[ip])),
-               h3_ratio=float(e["h3_amp_g"].iloc[ip] / abs(R[ip])), f_res_method=method,
-               flags=";".join(dict.fromkeys(flags)))
-    if force:
-        out["force_lbf"] = float(a_ref)
-    return out
-
-
-def _frf_quadrature(record: pd.DataFrame, row: dict, f_guess: float) -> float:
-    """Quadrature frequency of the whole-record FRF of z over a_base (Hz), near f_guess.
-
-    The ratio of the Fourier transforms over the full sweep is free of the sweep-rate
-    bias of time-local envelopes for a linear system; for a nonlinear one it is the
-    equivalent FRF at that drive level.
-    """
-    base = np.nan_to_num(record["base_accel_g"].to_numpy(float))
-    resp = np.nan_to_num(record["response_accel_g"].to_numpy(float))
-    fs = float(row["sample_rate_hz"])
-    B = np.fft.rfft(base - base.mean())
-    Rr = np.fft.rfft(resp - resp.mean())
-    fr = np.fft.rfftfreq(base.size, 1 / fs)
-    band = (fr > 0.8 * f_guess) & (fr < 1.2 * f_guess)
-    k = max(1, int(round(2.0 / (fr[1] - fr[0]))))  # ~2 Hz smoothing of cross and auto spectra
-    ker = np.ones(k) / k
-    cross = np.convolve((Rr - B) * np.conj(B), ker, "same")[band]
-    ph = np.unwrap(np.angle(-cross))  # z = -(a_resp - a_base)/omega^2
-    ph += 2 * np.pi * np.round((np.pi / 2 - np.median(ph)) / (2 * np.pi))
-    c = _crossing(ph, np.pi / 2)
-    if not c.size:
-        return np.nan
-    i = c[np.argmin(np.abs(fr[band][c] - f_guess))]
-    w = (np.pi / 2 - ph[i]) / (ph[i + 1] - ph[i])
-    return float(fr[band][i] + w * (fr[band][i + 1] - fr[band][i]))
+               h3_ratio=float(e["h3_amp_g"].iloc[ip] / abs(R[ip])), f_res_method=method)
+    if kind != "base":
+        out[REFERENCE[kind]] = float(a_ref)
+    return out, flags
 
 
 def measure_run(record: pd.DataFrame, row: dict, *, envelopes_kw: dict | None = None,
@@ -237,12 +313,17 @@ def measure_run(record: pd.DataFrame, row: dict, *, envelopes_kw: dict | None = 
     -------
     env : DataFrame
         The envelopes (see `jointcal.signal.envelopes`).
-    meta : EnvelopeMeta
+    meta : EnvelopeMeta or None
+        None when the record is too short for the envelope window (env is then empty).
     props : dict
         One row of modal_properties.csv.
     """
-    env, meta = envelopes(record, row, **(envelopes_kw or {}))
-    props = modal_properties(env, row, rate_hz_per_s=meta.rate_hz_per_s, record=record, **(modal_kw or {}))
+    try:
+        env, meta = envelopes(record, row, **(envelopes_kw or {}))
+        rate = meta.rate_hz_per_s
+    except ValueError:  # a chirp too short for the envelope window: the FRF path alone
+        env, meta, rate = pd.DataFrame(columns=ENVELOPE_COLUMNS), None, float(row["sweep_rate_hz_per_s"])
+    props = modal_properties(env, row, rate_hz_per_s=rate, record=record, **(modal_kw or {}))
     return env, meta, props
 
 
@@ -254,7 +335,7 @@ def scatter(table: pd.DataFrame) -> pd.DataFrame:
     quantity) with the dof-weighted pooled relative standard deviation (level NaN).
     Rows flagged unusable are left out.
     """
-    level = "level_g" if "level_g" in table.columns else "level_lbf"
+    level = next((c for c in LEVEL.values() if c in table.columns), "level_g")
     ok = ~table["flags"].fillna("").str.contains("unusable")
     rows = []
     for (asm), grp in table[ok].groupby("assembly", sort=False):

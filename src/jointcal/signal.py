@@ -19,6 +19,7 @@ from scipy.signal import ShortTimeFFT, savgol_filter
 from scipy.signal.windows import hann
 
 from ._checks import clipped_mask
+from ._contract import REFERENCE, RESPONSE
 from .models import G
 
 __all__ = ["EnvelopeMeta", "window_length", "track_drive", "envelopes", "meta_dict"]
@@ -113,7 +114,7 @@ def envelopes(df: pd.DataFrame, row: dict, *, zeta_min: float = 0.01, hop_fracti
     Parameters
     ----------
     df : DataFrame
-        The run record: time_s, base_accel_g (or force_lbf), response_accel_g.
+        The run record: time_s, base_accel_g (or force_lbf, or drive_V), response_accel_g.
     row : mapping
         Its manifest row (f_start_hz, f_stop_hz, sweep_rate_hz_per_s, sample_rate_hz).
     zeta_min : float
@@ -122,17 +123,17 @@ def envelopes(df: pd.DataFrame, row: dict, *, zeta_min: float = 0.01, hop_fracti
     Returns
     -------
     env : DataFrame, one row per frame
-        time_s, f_drive_hz, ref_re/ref_im (base g or force lbf), resp_re/resp_im (g),
-        z_re/z_im (relative displacement, in; for force-driven runs the response
-        displacement), h2_amp_g, h3_amp_g (response harmonics), noise_g (response at
+        time_s, f_drive_hz, ref_re/ref_im (base g, force lbf or drive V), resp_re/resp_im
+        (g), z_re/z_im (relative displacement, in; for force- and voltage-driven runs the
+        response displacement), h2_amp_g, h3_amp_g (response harmonics), noise_g (response at
         1.5x the drive: the noise floor), drive_on, bad (frames touching NaN or clipped
         samples).
     meta : EnvelopeMeta
     """
     fs = float(row["sample_rate_hz"])
-    kind = "force" if "force_lbf" in df.columns else "base"
-    ref = df["force_lbf" if kind == "force" else "base_accel_g"].to_numpy(dtype=float)
-    resp = df["response_accel_g"].to_numpy(dtype=float)
+    kind = next((k for k, c in REFERENCE.items() if c in df.columns), "base")
+    ref = df[REFERENCE[kind]].to_numpy(dtype=float)
+    resp = df[RESPONSE].to_numpy(dtype=float)
     # NaN/inf and clipped samples (the ingest stage's definition) are left out
     bad_sample = ~np.isfinite(ref) | ~np.isfinite(resp) | clipped_mask(ref) | clipped_mask(resp)
     ref = np.where(np.isfinite(ref), ref, 0.0)

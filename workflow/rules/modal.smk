@@ -9,6 +9,7 @@ rule modal_properties:
     output:
         table=RESULTS / "modal" / "modal_properties.csv",
         scatter=RESULTS / "modal" / "scatter.csv",
+        frf=directory(RESULTS / "modal" / "frf"),
     params:
         code=source_hash("modal.py"),
         modal=config["modal"],

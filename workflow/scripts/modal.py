@@ -1,7 +1,10 @@
-"""Snakemake script of rule ``modal_properties``: modal_properties.csv and scatter.csv.
+"""Snakemake script of rule ``modal_properties``: modal_properties.csv, scatter.csv, frf/.
 
 Every run gets a row; a run with problems gets flags and a one-sentence warning in the
-log and on stderr, never a silent drop. (No ``from __future__``: see envelopes.py.)
+log and on stderr, never a silent drop. Each run's whole-record FRF (H1, band-averaged
+H2 and coherence, the fitted displacement ratio; `jointcal.frf`) goes to
+``frf/<run_id>.csv``. A run the envelope stage could not process (a chirp too short
+for its window) still gets the FRF read-out. (No ``from __future__``: see envelopes.py.)
 """
 import json
 import sys
@@ -10,30 +13,42 @@ from pathlib import Path
 import pandas as pd
 
 from jointcal._checks import UNUSABLE_FLAGS
+from jointcal.frf import frf_table
 from jointcal.io import listed_record, read_run, write_csv_atomic
-from jointcal.modal import FLAG_WORDS, modal_properties, scatter
+from jointcal.modal import ENVELOPE_COLUMNS, FLAG_WORDS, modal_properties, scatter
 
 
 def main(smk) -> None:
     runs = pd.read_csv(smk.input.runs, dtype={"flags": str})
     env_dir = Path(smk.input.env[0]).parent
     records = list(smk.input.records)
+    frf_dir = Path(smk.output.frf)
+    frf_dir.mkdir(parents=True, exist_ok=True)
     rows, notes = [], []
     for row in runs.to_dict("records"):
         rid = row["run_id"]
         meta = json.loads((env_dir / f"{rid}.json").read_text())
         env = pd.read_csv(env_dir / f"{rid}.csv")
         ingest_flags = [f for f in str(row.get("flags") or "").split(";") if f and f != "nan"]
-        if meta.get("error"):
+        path = listed_record(str(row["file"]), records)  # whole relative path: basenames may repeat
+        record = read_run(path) if path else None
+        if meta.get("error") and record is None:
             out = {k: row.get(k) for k in ("run_id", "assembly", "sequence", "direction")}
             out["flags"] = ";".join(ingest_flags + ["unusable"])
             notes.append(f"{rid}: {meta['error']}")
         else:
-            path = listed_record(str(row["file"]), records)  # whole relative path: basenames may repeat
-            record = read_run(path) if path else None
-            out = modal_properties(env, row, rate_hz_per_s=meta["rate_hz_per_s"], record=record, **smk.params.modal)
+            if meta.get("error"):  # no envelopes: the whole-record FRF alone
+                env = pd.DataFrame(columns=list(ENVELOPE_COLUMNS))
+                notes.append(f"{rid}: {meta['error']} (the resonance comes from the whole-record FRF)")
+            rate = meta.get("rate_hz_per_s", row["sweep_rate_hz_per_s"])
+            out, frf = modal_properties(env, row, rate_hz_per_s=rate, record=record, with_frf=True,
+                                        **smk.params.modal)
             out["flags"] = ";".join(dict.fromkeys(ingest_flags + [f for f in out["flags"].split(";") if f]))
-            out["window_s"] = meta["window_s"]
+            out["window_s"] = meta.get("window_s")
+            if len(frf):
+                df_line = frf["freq_hz"].iloc[1] - frf["freq_hz"].iloc[0]  # zero-padded spacing, Hz
+                pad = max(1, int(round(row["sample_rate_hz"] / len(record) / df_line)))  # keep independent lines
+                write_csv_atomic(frf_table(frf.iloc[::pad].reset_index(drop=True), rid), frf_dir / f"{rid}.csv")
         wrong = [f for f in ingest_flags if f.split(":")[0] in UNUSABLE_FLAGS]
         if wrong and "unusable" not in out["flags"].split(";"):  # wrong units, level, channels; clipped: no fit
             out["flags"] = ";".join([*out["flags"].split(";"), "unusable"]).lstrip(";")

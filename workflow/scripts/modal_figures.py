@@ -14,7 +14,7 @@ def main(smk) -> None:
     envs = {Path(p).stem: pd.read_csv(p) for p in smk.input.env}
     plot_envelopes(table, envs, smk.output.envelopes)
     plot_frequency_damping(table, smk.output.amplitude)
-    level = "level_g" if "level_g" in runs.columns else "level_lbf"
+    level = next((c for c in ("level_g", "level_lbf", "level_V") if c in runs.columns), "level_g")
     rid = runs.sort_values([level, "sequence"]).iloc[-1]["run_id"]  # the strongest run
     row = runs.loc[rid]
     lo = min(row["f_start_hz"], row["f_stop_hz"])

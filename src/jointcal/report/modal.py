@@ -35,8 +35,8 @@ def plot_envelopes(table: pd.DataFrame, envs: dict[str, pd.DataFrame], path) -> 
     1 g repeats); a level without a down sweep shows its last run.
     """
     plt = _plt()
-    level = "level_g" if "level_g" in table.columns else "level_lbf"
-    unit = "g" if level == "level_g" else "lbf"
+    level = next((c for c in ("level_g", "level_lbf", "level_V") if c in table.columns), "level_g")
+    unit = level.split("_")[1]
     asms = list(dict.fromkeys(table["assembly"]))
     fig, axes = plt.subplots(1, len(asms), figsize=(5.5 * len(asms), 4.0), squeeze=False, sharey=True)
     for ax, asm in zip(axes[0], asms):

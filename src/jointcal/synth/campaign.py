@@ -15,11 +15,14 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from dataclasses import replace
+
 from ..io import write_csv_atomic, write_json_atomic, write_run
 from ..models import G, resonance_amplitude, simulate
 from . import daq
 from .effects import effect_defaults, run_model
-from .spec import load_spec
+from .shaker import Shaker, rig_truth, simulate_rig
+from .spec import JOINT_KEYS, RIG_LEVEL, load_spec
 
 __all__ = ["generate", "plan_runs"]
 
@@ -27,10 +30,18 @@ _RANGES_G = (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000)
 
 
 def plan_runs(spec: dict) -> pd.DataFrame:
-    """The manifest rows of a spec's test series, before any simulation."""
+    """The manifest rows of a spec's test series, before any simulation.
+
+    A force-driven rig's rows carry the amplifier's level_V and a NaN level_lbf: the
+    force the gauge measures is known after the simulation (`generate` fills it in and
+    drops level_V from the manifest).
+    """
     rows = []
     sw = spec["sweep"]
     lo, hi = sorted((sw["f_start_hz"], sw["f_stop_hz"]))
+    ref = spec.get("rig", {}).get("reference", "base")
+    key = RIG_LEVEL[ref]
+    unit = key.split("_")[1]
     for assembly in spec["assemblies"]:
         seq = 0
         for item in spec["series"]:
@@ -38,8 +49,10 @@ def plan_runs(spec: dict) -> pd.DataFrame:
                 for direction in item.get("directions", ["up", "down"]):
                     seq += 1
                     f0, f1 = (lo, hi) if direction == "up" else (hi, lo)
-                    run_id = f"{assembly}_{seq:02d}_{item['level_g']:g}g_{direction}"
-                    rows.append(dict(run_id=run_id, assembly=assembly, sequence=seq, level_g=float(item["level_g"]),
+                    run_id = f"{assembly}_{seq:02d}_{item[key]:g}{unit}_{direction}"
+                    level = {key: float(item[key])} if ref != "force" else {"level_V": float(item[key]),
+                                                                            "level_lbf": np.nan}
+                    rows.append(dict(run_id=run_id, assembly=assembly, sequence=seq, **level,
                                      direction=direction, f_start_hz=f0, f_stop_hz=f1,
                                      sweep_rate_hz_per_s=float(sw["rate_hz_per_s"]),
                                      sample_rate_hz=float(spec["sample_rate_hz"]),
@@ -56,8 +69,22 @@ def _full_scale(setting: Any, peak: float) -> float:
 
 def _truth_row(truth: dict, model, level: float) -> dict:
     iw = model.iwan
+    if iw is None:  # linear structure: phase resonance m a = c w q
+        w = np.sqrt(model.k / model.m)
+        q = level * G / (2 * model.zeta_v * w**2)
+        return dict(Fs=np.nan, KT=np.nan, q_hb_in=float(q), f_hb_hz=float(w / (2 * np.pi)), zeta_hb=model.zeta_v)
     q, f, z = resonance_amplitude(level, iw.Fs, iw.KT, iw.chi, iw.beta, model.k, model.m, model.zeta_v)
     return dict(Fs=iw.Fs, KT=iw.KT, q_hb_in=float(q), f_hb_hz=float(f), zeta_hb=float(z))
+
+
+_PLACEHOLDER_JOINT = {"Fs": 1.0, "KT": 1.0, "chi": -0.5, "beta": 0.1}
+
+
+def _model(truth: dict, sequence: int, effect: str, eparams: dict):
+    """The run's model: `run_model`, or its linear version for an assembly without a joint."""
+    if all(k in truth for k in JOINT_KEYS):
+        return run_model(truth, sequence, effect, eparams)
+    return replace(run_model({**truth, **_PLACEHOLDER_JOINT}, sequence, effect, eparams), iwan=None)
 
 
 def generate(spec: dict | str | os.PathLike, out_dir: str | os.PathLike, truth_path: str | os.PathLike) -> pd.DataFrame:
@@ -85,31 +112,48 @@ def generate(spec: dict | str | os.PathLike, out_dir: str | os.PathLike, truth_p
     sos = daq.antialias(fs_sim, fs_out, meas["antialias_order"], meas["antialias_cutoff"])
     effect = spec["effect"]["name"]
     eparams = effect_defaults(effect, spec["effect"].get("params"))
-    m = spec["slug_weight_lbf"] / G
     sw = spec["sweep"]
+    ref = spec["rig"]["reference"]
+    shaker = Shaker(**spec["rig"]["shaker"])
     plan = plan_runs(spec)
+    masses = {a: v.get("weight_lbf", spec["slug_weight_lbf"]) / G for a, v in spec["assemblies"].items()}
     truth_rows = []
-    for row in plan.itertuples(index=False):
+    for i, row in enumerate(plan.itertuples(index=False)):
         run_rng = np.random.default_rng([spec["seed"], int(rng.integers(2**31))])
-        truth = dict(spec["assemblies"][row.assembly], m=m)
-        model = run_model(truth, row.sequence, effect, eparams)
-        t, f_inst, base = daq.controlled_sweep(fs_sim, row.f_start_hz, row.f_stop_hz, row.sweep_rate_hz_per_s,
-                                               row.level_g, rng=run_rng, ramp_s=sw["ramp_s"], tail_s=sw["tail_s"],
-                                               ripple=meas["ripple"], distortion=tuple(meas["distortion"]))
-        resp = simulate(model, base, fs_sim, omega_h=0.3).response_g  # truth finer than any estimator
+        truth = {k: v for k, v in spec["assemblies"][row.assembly].items() if k != "weight_lbf"}
+        truth["m"] = masses[row.assembly]
+        model = _model(truth, row.sequence, effect, eparams)
+        level = row.level_g if ref == "base" else row.level_V
+        # base: the controller holds the base acceleration (ripple); a rig's amplifier is open loop
+        t, f_inst, drive = daq.controlled_sweep(fs_sim, row.f_start_hz, row.f_stop_hz, row.sweep_rate_hz_per_s,
+                                           level, rng=run_rng, ramp_s=sw["ramp_s"], tail_s=sw["tail_s"],
+                                           ripple=meas["ripple"] if ref == "base" else 0.0,
+                                           distortion=tuple(meas["distortion"]))
+        if ref == "base":
+            reference, resp = drive, simulate(model, drive, fs_sim, omega_h=0.3).response_g  # truth finer than any estimator
+            extra = _truth_row(truth, model, row.level_g)
+        else:
+            resp, force, x = simulate_rig(model, shaker, drive, fs_sim, omega_h=0.3)
+            reference = force if ref == "force" else drive
+            extra = rig_truth(model, shaker, level, t, f_inst, x)
+            extra = dict(Fs=truth.get("Fs", np.nan), KT=truth.get("KT", np.nan), level_V=level, **extra)
+            if ref == "force":  # the manifest's level: the force amplitude the gauge saw over the sweep
+                on = np.abs(drive) > 0
+                level_lbf = float(np.sqrt(2 * np.mean(force[on] ** 2)))
+                plan.loc[i, "level_lbf"] = extra["level_lbf"] = round(level_lbf, 6)
         chans, ranges = [], {}
-        for name, x in (("base", base), ("response", resp)):
+        for name, x in (("base", reference), ("response", resp)):
             fsg = ranges[f"full_scale_{name}_g"] = _full_scale(meas["full_scale_g"][name], float(np.max(np.abs(x))))
             off = ranges[f"dc_offset_{name}_g"] = float(meas["dc_offset_g"] * run_rng.standard_normal())
             chans.append(daq.measure(x, fs_sim, fs_out, rng=run_rng, noise_fraction=meas["noise_fraction"],
                                      dc_offset=off, full_scale_g=fsg, bits=meas["bits"], sos=sos))
-        write_run(out_dir / row.file, t[:: int(meas["oversample"])], chans[0], chans[1], kind="base")
+        write_run(out_dir / row.file, t[:: int(meas["oversample"])], chans[0], chans[1], kind=ref)
+        lev = {"level_g": row.level_g} if ref == "base" else {}
         truth_rows.append(dict(run_id=row.run_id, assembly=row.assembly, sequence=row.sequence,
-                               level_g=row.level_g, direction=row.direction, **ranges,
-                               **_truth_row(truth, model, row.level_g)))
-    write_csv_atomic(plan, out_dir / "manifest.csv")
+                               **lev, direction=row.direction, **ranges, **extra))
+    write_csv_atomic(plan.drop(columns=["level_V"]) if ref == "force" else plan, out_dir / "manifest.csv")
     table = pd.DataFrame(truth_rows)
     write_json_atomic(dict(spec=spec, effect=dict(name=effect, params=eparams),
-                           assemblies={a: dict(v, m=m) for a, v in spec["assemblies"].items()},
+                           assemblies={a: dict(v, m=masses[a]) for a, v in spec["assemblies"].items()},
                            runs=table.to_dict(orient="records")), truth_path)
     return table

@@ -9,8 +9,20 @@ slug_weight_lbf      slug weight (mass = weight / 386.089).
 sweep                f_start_hz, f_stop_hz (the band, low or high first), rate_hz_per_s,
                      ramp_s (cosine ramps), tail_s (free decay recorded after the sweep).
 series               list of {level_g, directions: [up, down], repeats}: the test order
-                     of each assembly (the paper's Table 3.1 by default).
-assemblies           {name: {Fs, KT, chi, beta, k, zeta_v}} (Table 3.2 by default).
+                     of each assembly (the paper's Table 3.1 by default); for a shaker
+                     rig (rig.reference force or voltage) level_V, the amplifier's
+                     voltage amplitude (V), instead of level_g.
+assemblies           {name: {Fs, KT, chi, beta, k, zeta_v}} (Table 3.2 by default); the
+                     four joint keys may all be left out (a linear structure), and
+                     weight_lbf gives an assembly its own slug weight.
+rig                  reference: base (the paper's closed-loop base-acceleration control,
+                     default) | force | voltage: an open-loop electrodynamic shaker on the
+                     slug (`jointcal.synth.shaker`), recording the force gauge (force_lbf,
+                     manifest level_lbf = the force amplitude over the sweep, lbf) or the
+                     amplifier voltage (drive_V, level_V); shaker: armature_weight_lbf,
+                     suspension_hz, suspension_zeta, bl_lbf_per_A, coil_ohm, coil_mH.
+                     The sweep's rate_hz_per_s sets fast chirps as well (eta =
+                     rate / (f zeta)^2 from 0.1 to 20 and beyond).
 measurement          noise_fraction (of each channel's RMS), dc_offset_g (std), bits,
                      full_scale_g {base, response} ('auto' or g), oversample (simulation
                      rate / output rate), antialias_order, antialias_cutoff (x output
@@ -28,6 +40,7 @@ from pathlib import Path
 import yaml
 
 from .effects import effect_defaults
+from .shaker import Shaker
 
 __all__ = ["DEFAULT_SPEC", "load_spec"]
 
@@ -50,7 +63,10 @@ DEFAULT_SPEC: dict = {
                     "full_scale_g": {"base": "auto", "response": "auto"}, "oversample": 2,
                     "antialias_order": 8, "antialias_cutoff": 0.42, "ripple": 0.01, "distortion": [0.003, 0.002]},
     "effect": {"name": "none", "params": {}},
+    "rig": {"reference": "base", "shaker": {}},
 }
+JOINT_KEYS = ("Fs", "KT", "chi", "beta")
+RIG_LEVEL = {"base": "level_g", "force": "level_V", "voltage": "level_V"}  # series key per rig reference
 
 
 def _merge(base: dict, over: dict) -> dict:
@@ -84,9 +100,16 @@ def _coerce(s: dict, where: str) -> None:
             raise ValueError(f"{where}: assembly {name!r} must map Fs, KT, chi, beta, k, zeta_v to numbers.")
         for key in a:
             a[key] = _number(a[key], where, f"assemblies.{name}.{key}")
+    level = RIG_LEVEL.get(s["rig"].get("reference"), "level_g")
     for item in s["series"]:
-        item["level_g"] = _number(item.get("level_g"), where, "series level_g")
+        if level not in item:
+            raise ValueError(f"{where}: series item {item} needs {level} for a rig with reference "
+                             f"{s['rig'].get('reference')!r}.")
+        item[level] = _number(item.get(level), where, f"series {level}")
         item["repeats"] = int(_number(item.get("repeats", 1), where, "series repeats"))
+    sh = s["rig"].get("shaker") or {}
+    for key in sh:
+        sh[key] = _number(sh[key], where, f"rig.shaker.{key}")
     m = s["measurement"]
     for key in ("noise_fraction", "dc_offset_g", "antialias_cutoff", "ripple"):
         m[key] = _number(m[key], where, f"measurement.{key}")
@@ -173,12 +196,26 @@ def load_spec(spec: dict | str | os.PathLike) -> dict:
         raise ValueError(f"{where}: sample_rate_hz {s['sample_rate_hz']} is too low for a band up to "
                          f"{max(sw['f_start_hz'], sw['f_stop_hz'])} Hz; use at least 2.3x the top frequency.")
     for name, a in s["assemblies"].items():
-        missing = {"Fs", "KT", "chi", "beta", "k", "zeta_v"} - set(a)
-        if missing:
-            raise ValueError(f"{where}: assembly {name!r} lacks {sorted(missing)}.")
+        missing = {"k", "zeta_v"} - set(a)
+        joint = [k for k in JOINT_KEYS if k in a]
+        if missing or 0 < len(joint) < len(JOINT_KEYS):
+            raise ValueError(f"{where}: assembly {name!r} lacks {sorted(missing | (set(JOINT_KEYS) - set(joint)))} "
+                             "(give k, zeta_v and all of Fs, KT, chi, beta, or none of these four for a linear structure).")
+    rig = s["rig"]
+    if set(rig) - {"reference", "shaker"} or rig.get("reference") not in RIG_LEVEL:
+        raise ValueError(f"{where}: rig must be {{reference: base | force | voltage, shaker: {{...}}}}, got {rig}.")
+    try:
+        rig["shaker"] = {**Shaker().__dict__, **(rig.get("shaker") or {})}
+        Shaker(**rig["shaker"])
+    except TypeError as exc:
+        raise ValueError(f"{where}: rig.shaker: {exc}; its keys are {sorted(Shaker().__dict__)}.") from None
+    if rig["reference"] != "base" and s["effect"]["name"] == "fixture_flexibility":
+        raise ValueError(f"{where}: the fixture_flexibility effect needs rig.reference base (a shaker rig has a "
+                         "rigid base).")
+    level = RIG_LEVEL[rig["reference"]]
     for item in s["series"]:
-        if not (item.get("level_g", 0) > 0) or any(d not in ("up", "down") for d in item.get("directions", ["up"])):
-            raise ValueError(f"{where}: series item {item} needs level_g > 0 and directions among up/down.")
+        if not (item.get(level, 0) > 0) or any(d not in ("up", "down") for d in item.get("directions", ["up"])):
+            raise ValueError(f"{where}: series item {item} needs {level} > 0 and directions among up/down.")
     m = s["measurement"]
     if not (0 <= m["noise_fraction"] < 1 and m["bits"] >= 8 and int(m["oversample"]) >= 1):
         raise ValueError(f"{where}: measurement needs 0 <= noise_fraction < 1, bits >= 8, oversample >= 1; got {m}.")

@@ -1,0 +1,165 @@
+"""Shaker rigs (jointcal.synth.shaker) and their campaigns: force- and voltage-referenced drives.
+
+The full eta 0.1-20 x {force, voltage} x {Ministack, 100 Hz beam} matrix is in
+tests/benchmarks/accept_rigs.py; here one short case per kind.
+"""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from jointcal.frf import record_frf
+from jointcal.io import ingest_campaign, read_manifest, read_run
+from jointcal.modal import measure_run
+from jointcal.models import G, IwanParams, MinistackModel
+from jointcal.synth import generate, load_spec
+from jointcal.synth.daq import controlled_sweep
+from jointcal.synth.shaker import Shaker, _rig_poly, rig_pole, simulate_rig
+
+BEAM = {"k": 1022.0, "zeta_v": 0.015, "weight_lbf": 1.0}  # 100 Hz, zeta 1.5%, linear
+SHAKER = {"armature_weight_lbf": 0.05, "suspension_hz": 15.0, "bl_lbf_per_A": 0.5, "coil_ohm": 2.0, "coil_mH": 0.3}
+MINISTACK = {"Fs": 313.0, "KT": 1.02e6, "chi": -0.65, "beta": 0.004, "k": 6.12e5, "zeta_v": 0.0015}
+
+
+def test_time_simulation_of_the_rig_matches_its_analytic_frf():
+    """Exact-propagator time integration of the 3-state rig vs the closed-form x/V (linear beam).
+
+    Independent paths: the integrator (matrix exponentials, Hermite input) against the
+    polynomial (R + i w L)(K - M w^2 + i w C) + i w Bl Bl_e. 0.5% near the peak leaves
+    room for the sampled-input interpolation only.
+    """
+    m = BEAM["weight_lbf"] / G
+    model, sh = MinistackModel(m=m, k=BEAM["k"], zeta_v=BEAM["zeta_v"]), Shaker(**SHAKER)
+    fs = 2048.0
+    t, _, v = controlled_sweep(2 * fs, 80.0, 120.0, 10.0, 1.0, rng=np.random.default_rng(0), ramp_s=0.05,
+                               tail_s=1.0, ripple=0.0, distortion=(0.0, 0.0))
+    acc, force, _ = simulate_rig(model, sh, v, 2 * fs)
+    tab, fit = record_frf(v[::2], acc[::2], fs, "voltage", (80.0, 120.0))
+    f = tab["freq_hz"].to_numpy()
+    den, bl = _rig_poly(model, sh, 1.0)
+    w = 2 * np.pi * f
+    h = -(w**2) * bl / np.polyval(den, 1j * w) / G
+    fr, zr = rig_pole(model, sh, 1.0)
+    near = np.abs(f - fr) <= 2 * zr * fr
+    H = (tab["h1_re"] + 1j * tab["h1_im"]).to_numpy()
+    assert np.abs(np.abs(H[near]) / np.abs(h[near]) - 1).max() < 5e-3
+    assert fit.f_n_hz == pytest.approx(fr, rel=5e-4) and fit.zeta == pytest.approx(zr, rel=0.01)
+    # the rig's mode sits below the structure's (armature mass) and is more damped (back-EMF)
+    assert fr < 100.0 and zr > BEAM["zeta_v"]
+    # the gauge force drops out near the structure's own resonance (F/V = Z_s x/V: its minimum
+    # lies within the structure's half-power band), and response / force is the structure alone
+    tab_f, _ = record_frf(v[::2], force[::2], fs, "voltage", (80.0, 120.0))
+    hf = np.abs(tab_f["h1_re"] + 1j * tab_f["h1_im"]).to_numpy()
+    assert abs(f[np.argmin(hf)] - 100.0) < 0.015 * 100.0
+    assert hf.min() < 0.6 * np.median(hf)  # depth set by the back-EMF damping: 0.52 here, 0.2 on the Ministack
+    _, fit_s = record_frf(force[::2], acc[::2], fs, "force", (80.0, 120.0))
+    assert fit_s.f_quad_hz == pytest.approx(100.0, rel=5e-4) and fit_s.zeta == pytest.approx(0.015, rel=0.01)
+
+
+def _campaign(tmp_path, ref: str, assembly: dict, band, fs, rate, volts, tail=1.0):
+    spec = {"seed": 5, "sample_rate_hz": fs, "sweep": {"f_start_hz": band[0], "f_stop_hz": band[1],
+                                                        "rate_hz_per_s": rate, "tail_s": tail},
+            "series": [{"level_V": volts, "directions": ["up"]}], "assemblies": {"s": assembly},
+            "rig": {"reference": ref, "shaker": SHAKER if "weight_lbf" in assembly else {}}}
+    generate(spec, tmp_path / "c", tmp_path / "t.json")
+    runs = ingest_campaign(tmp_path / "c")
+    row = read_manifest(tmp_path / "c" / "manifest.csv").iloc[0].to_dict()
+    props = measure_run(read_run(tmp_path / "c" / row["file"]), row,
+                        modal_kw={"mass_lbf": assembly.get("weight_lbf", 2.65)})[2]
+    return runs, props, json.loads((tmp_path / "t.json").read_text())["runs"][0]
+
+
+@pytest.mark.parametrize("ref, eta", [("voltage", 20.0), ("force", 2.0)])
+def test_beam_rig_campaign_recovers_the_truth(tmp_path, ref, eta):
+    """100 Hz beam, open-loop shaker: f within 0.2%, zeta within 5% of the truth; method named."""
+    f, z = (97.658, 0.0192) if ref == "voltage" else (100.0, 0.015)  # the rig's pole / the structure's
+    runs, props, truth = _campaign(tmp_path, ref, BEAM, (70.0, 130.0), 1024.0, eta * (f * z) ** 2, 1.0)
+    key_f, key_z = ("f_rig_hz", "zeta_rig") if ref == "voltage" else ("f_hb_hz", "zeta_hb")
+    print(f"\n{ref} eta {eta}: f err {100 * (props['f_res_hz'] / truth[key_f] - 1):+.4f}%, zeta err "
+          f"{100 * (props['zeta_frf'] / truth[key_z] - 1):+.2f}%, method {props['f_res_method']}, eta {props['eta']:.2f}")
+    assert runs.loc[0, "excitation"] == ref
+    assert ("level_V" if ref == "voltage" else "level_lbf") in runs.columns
+    assert props["f_res_method"] == "frf_fit"
+    assert props["f_res_hz"] == pytest.approx(truth[key_f], rel=2e-3)
+    assert props["zeta_frf"] == pytest.approx(truth[key_z], rel=0.05)
+    assert props["eta"] == pytest.approx(eta, rel=0.1)
+    if ref == "voltage":
+        assert np.isnan(props["zeta_phase_resonance"])  # no absolute force, no energy balance
+    else:
+        assert props["zeta_phase_resonance"] == pytest.approx(truth[key_z], rel=0.05)  # mass given
+
+
+def test_ministack_force_rig_slow_chirp(tmp_path):
+    """The Table 3.2 joint behind a force gauge at eta ~0.5: f_res within 0.2% of the steady state."""
+    rate = 0.5 * (2320.0 * 0.019) ** 2
+    runs, props, truth = _campaign(tmp_path, "force", MINISTACK, (1500.0, 2700.0), 12800.0, rate, 3.2281, tail=0.1)
+    print(f"\nMinistack force: f err {100 * (props['f_res_hz'] / truth['f_hb_hz'] - 1):+.4f}% "
+          f"(q_ss {truth['q_ss_in']:.2e} in), zeta (energy balance) err "
+          f"{100 * (props['zeta_phase_resonance'] / truth['zeta_hb'] - 1):+.2f}%, fit "
+          f"{100 * (props['zeta_frf'] / truth['zeta_hb'] - 1):+.2f}%")
+    assert props["f_res_method"] == "frf_fit"
+    assert props["f_res_hz"] == pytest.approx(truth["f_hb_hz"], rel=2e-3)
+
+
+def test_rig_spec_is_validated():
+    with pytest.raises(ValueError, match="level_V"):
+        load_spec({"seed": 1, "rig": {"reference": "voltage"}})  # the default series gives level_g
+    with pytest.raises(ValueError, match="reference"):
+        load_spec({"seed": 1, "rig": {"reference": "laser"}})
+    with pytest.raises(ValueError, match="coil_ohm"):
+        load_spec({"seed": 1, "rig": {"reference": "force", "shaker": {"coil_ohm": -1.0}},
+                   "series": [{"level_V": 1.0}]})
+    with pytest.raises(ValueError, match="Fs"):
+        load_spec({"seed": 1, "assemblies": {"a": {"k": 1.0, "zeta_v": 0.01, "KT": 1.0}}})
+    s = load_spec({"seed": 1, "rig": {"reference": "force"}, "series": [{"level_V": 2.0}],
+                   "assemblies": {"beam": BEAM}})
+    assert s["rig"]["shaker"]["bl_lbf_per_A"] == Shaker().bl_lbf_per_A
+
+
+def test_rig_model_keeps_the_joint():
+    """The rig integrates the exact Iwan joint: at a large drive the resonance softens."""
+    m = 2.65 / G
+    model = MinistackModel(m=m, k=MINISTACK["k"], zeta_v=MINISTACK["zeta_v"],
+                           iwan=IwanParams(313.0, 1.02e6, -0.65, 0.004))
+    sh = Shaker()
+    lo, hi = rig_pole(model, sh, 1e-7), rig_pole(model, sh, 2e-4)
+    assert hi[0] < 0.95 * lo[0] and hi[1] > lo[1]
+
+
+@pytest.mark.slow
+def test_workflow_reads_a_voltage_driven_chirp_campaign(tmp_path):
+    """Workflow 'modal_properties' on a voltage-driven beam campaign (eta-20 chirps, up and down):
+    ingest takes level_V / drive_V, the modal stage reads the rig's pole, each run's FRF is written."""
+    import shutil
+    import subprocess
+    import sys
+
+    import pandas as pd
+    from _campaign import REPO
+
+    spec = {"seed": 8, "sample_rate_hz": 1024.0, "sweep": {"f_start_hz": 70.0, "f_stop_hz": 130.0,
+                                                           "rate_hz_per_s": 20.0 * (97.66 * 0.0192) ** 2,
+                                                           "tail_s": 1.0},
+            "series": [{"level_V": 1.0, "directions": ["up", "down"]}], "assemblies": {"beam": BEAM},
+            "rig": {"reference": "voltage", "shaker": SHAKER}}
+    generate(spec, tmp_path / "c", tmp_path / "t.json")
+    truth = json.loads((tmp_path / "t.json").read_text())["runs"]
+    work = tmp_path / "wf"
+    work.mkdir()
+    shutil.copy(REPO / "Snakefile", work)
+    for folder in ("workflow", "profiles"):
+        shutil.copytree(REPO / folder, work / folder, ignore=shutil.ignore_patterns("__pycache__"))
+    out = tmp_path / "results"
+    res = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", "modal_properties", "--config",
+                          f"raw_data={tmp_path / 'c'}", f"results={out}"], cwd=work, capture_output=True,
+                         text=True, timeout=600)
+    assert res.returncode == 0, res.stderr[-3000:]
+    t = pd.read_csv(out / "modal" / "modal_properties.csv", dtype={"flags": str})
+    assert (t["f_res_method"] == "frf_fit").all() and "level_V" in t.columns
+    for r, tr in zip(t.to_dict("records"), truth):
+        assert r["f_res_hz"] == pytest.approx(tr["f_rig_hz"], rel=2e-3)
+        assert r["zeta_frf"] == pytest.approx(tr["zeta_rig"], rel=0.05)
+        frf = pd.read_csv(out / "modal" / "frf" / f"{r['run_id']}.csv")
+        assert {"h1_re", "h2_re", "coherence", "fit_re"} <= set(frf.columns)
