@@ -3,9 +3,10 @@ from .amplitude import G, harmonic_balance, jenkins_inphase, qsma, resonance_amp
 from .iwan import IwanParams, backbone, backbone_stiffness, derived, dissipation, force_history
 from .simulate import SimResult, fractional_delay, simulate
 from .structure import Fixture, MinistackModel, state_space
+from .envelope import SteadyState, steady_state
 
 __all__ = [
     "G", "IwanParams", "derived", "backbone", "backbone_stiffness", "dissipation", "force_history",
     "qsma", "harmonic_balance", "jenkins_inphase", "resonance_amplitude",
-    "MinistackModel", "Fixture", "state_space", "simulate", "SimResult", "fractional_delay",
+    "MinistackModel", "Fixture", "SteadyState", "steady_state", "state_space", "simulate", "SimResult", "fractional_delay",
 ]

@@ -45,13 +45,14 @@ class IwanParams:
     beta: float
 
     def __post_init__(self) -> None:
-        if not (self.Fs > 0 and np.isfinite(self.Fs)):
+        Fs, KT, chi, beta = (np.asarray(v) for v in (self.Fs, self.KT, self.chi, self.beta))  # arrays: a batch
+        if not np.all((Fs > 0) & np.isfinite(Fs)):
             raise ValueError(f"Iwan Fs must be a positive force in lbf, got {self.Fs!r}.")
-        if not (self.KT > 0 and np.isfinite(self.KT)):
+        if not np.all((KT > 0) & np.isfinite(KT)):
             raise ValueError(f"Iwan KT must be a positive stiffness in lbf/in, got {self.KT!r}.")
-        if not (-1.0 < self.chi <= 0.0):
+        if not np.all((-1.0 < chi) & (chi <= 0.0)):
             raise ValueError(f"Iwan chi must lie in (-1, 0], got {self.chi!r}.")
-        if not (self.beta >= 0 and np.isfinite(self.beta)):
+        if not np.all((beta >= 0) & np.isfinite(beta)):
             raise ValueError(f"Iwan beta must be >= 0, got {self.beta!r}.")
 
 

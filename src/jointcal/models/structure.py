@@ -79,11 +79,11 @@ class MinistackModel:
     def __post_init__(self) -> None:
         for name in ("m", "k"):
             v = getattr(self, name)
-            if not (np.isfinite(v) and v > 0):
+            if not np.all(np.isfinite(v) & (np.asarray(v) > 0)):  # arrays: a batch of parameter sets
                 raise ValueError(f"MinistackModel.{name} must be positive and finite, got {v!r}.")
-        if not (0 <= self.zeta_v < 1):
+        if not np.all((np.asarray(self.zeta_v) >= 0) & (np.asarray(self.zeta_v) < 1)):
             raise ValueError(f"MinistackModel.zeta_v must lie in [0, 1), got {self.zeta_v!r}.")
-        if not (self.sensor_gain > 0):
+        if not np.all(np.asarray(self.sensor_gain) > 0):
             raise ValueError(f"sensor_gain must be positive, got {self.sensor_gain!r}.")
 
     @property

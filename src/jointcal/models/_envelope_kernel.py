@@ -1,0 +1,209 @@
+"""Numba kernel of the steady-state envelope model (private; see `jointcal.models.envelope`).
+
+For every parameter set the first-harmonic balance of the joint DOF reduces to one
+scalar fixed point in s = log q (q the joint's relative amplitude, in):
+
+    r(s) = s + log|K_z(q, omega) - mu(omega)| - log|B(omega)| = 0,
+
+with K_z the joint DOF's complex dynamic stiffness at amplitude q (linear spring,
+dashpot, Iwan describing function, cubic spring, quadratic damper) and mu, B the
+effective inertia and effective base load of the structure around it (a rigid base:
+mu = m omega^2, B = m A; a flexible fixture: see `envelope._structure_terms`). Stable
+branches have dr/ds > 0. The kernel marches over the frequencies in sweep order and
+continues the branch of the previous frequency by a bracketed Newton iteration; when
+the branch ends at a fold the iteration lands on the other branch, which is flagged.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+__all__: list[str] = []
+
+PI = np.pi
+
+
+@njit(cache=True, inline="always")
+def _jenkins(s):
+    """In-phase first-harmonic stiffness g(s) of a unit Jenkins element (s = phi/q)."""
+    if s >= 1.0:
+        return 1.0
+    if s <= 0.0:
+        return 0.0
+    th = np.arccos(1.0 - 2.0 * s)
+    return (th - 0.5 * np.sin(2.0 * th)) / PI
+
+
+@njit(cache=True)
+def _J(chi, smax, nodes, weights):
+    """J = int_0^smax (1 - g(s)) s^chi ds (as `amplitude._J`: split at s = 1/2)."""
+    a = chi + 1.0
+    t_a = min(smax, 0.5) ** a
+    low = 0.0
+    for i in range(nodes.shape[0]):
+        s = (t_a * nodes[i]) ** (1.0 / a)
+        low += weights[i] * (1.0 - _jenkins(s))
+    low *= t_a / a
+    high = 0.0
+    if smax > 0.5:
+        th0 = 0.5 * PI
+        th1 = np.arccos(1.0 - 2.0 * smax)
+        for i in range(nodes.shape[0]):
+            th = th0 + (th1 - th0) * nodes[i]
+            sb = 0.5 * (1.0 - np.cos(th))
+            omg = 1.0 - (th - 0.5 * np.sin(2.0 * th)) / PI
+            high += weights[i] * omg * sb**chi * 0.5 * np.sin(th)
+        high *= th1 - th0
+    return low + high
+
+
+@njit(cache=True, inline="always")
+def _stiffness(q, s, w, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights):
+    """Complex dynamic stiffness of the joint DOF at amplitude q (in) and omega w (rad/s).
+
+    Returns (Re, Im, dRe/ds, dIm/ds) with s = log q (passed too: q^e = exp(e s)). kp: linear springs in parallel
+    (k); c: dashpot; Iwan (KT, R, chi, phimax, S; J1 = J(chi, 1)); k3 cubic; c2 quadratic.
+    """
+    re = kp
+    im = w * c
+    dre = 0.0
+    dim = 0.0
+    if KT > 0.0:
+        e = chi + 1.0
+        if q <= phimax:
+            p = R * np.exp(e * s)
+            re += KT - p * J1  # in-phase stiffness of the power-law sliders
+            dre -= e * p * J1
+            Dq = 4.0 * p / (PI * (chi + 2.0) * (chi + 3.0))  # D(q)/(pi q^2), D = 4 R q^(chi+3)/((chi+2)(chi+3))
+            im += Dq
+            dim += e * Dq
+        else:  # macroslip: finite differences in s of the exact describing function
+            h = 1e-6
+            vals = np.empty(4)
+            for j in range(2):
+                qq = q * np.exp(h if j == 0 else -h)
+                sm = phimax / qq
+                kin = KT - R * qq**e * _J(chi, sm, nodes, weights) - S * (1.0 - _jenkins(sm))
+                u = phimax
+                D = 4.0 * R * (qq * u ** (chi + 2.0) / (chi + 2.0) - u ** (chi + 3.0) / (chi + 3.0))
+                D += 4.0 * S * phimax * (qq - phimax)
+                vals[2 * j] = kin
+                vals[2 * j + 1] = D / (PI * qq * qq)
+            sm = phimax / q
+            re += KT - R * q**e * _J(chi, sm, nodes, weights) - S * (1.0 - _jenkins(sm))
+            u = phimax
+            D = 4.0 * R * (q * u ** (chi + 2.0) / (chi + 2.0) - u ** (chi + 3.0) / (chi + 3.0))
+            D += 4.0 * S * phimax * (q - phimax)
+            im += D / (PI * q * q)
+            dre += (vals[0] - vals[2]) / (2.0 * h)
+            dim += (vals[1] - vals[3]) / (2.0 * h)
+    if k3 != 0.0:
+        t = 0.75 * k3 * q * q  # cubic spring: 3/4 k3 q^2 in phase
+        re += t
+        dre += 2.0 * t
+    if c2 != 0.0:
+        t = 8.0 * c2 * w * w * q / (3.0 * PI)  # quadratic damper: omega c_eq, c_eq = 8 c2 omega q / (3 pi)
+        im += t
+        dim += t
+    return re, im, dre, dim
+
+
+@njit(cache=True, inline="always")
+def _residual(s, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights):
+    """r(s) and dr/ds of the amplitude fixed point."""
+    q = np.exp(s)
+    re, im, dre, dim = _stiffness(q, s, w, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights)
+    x = re - mu_re
+    y = im - mu_im
+    m2 = x * x + y * y
+    r = s + 0.5 * np.log(m2) - logB
+    dr = 1.0 + (x * dre + y * dim) / m2
+    return r, dr, re, im
+
+
+@njit(cache=True)
+def _root(s0, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights, tol):
+    """A stable root of r near s0 (bracketed Newton), and whether the walk left a vanished branch.
+
+    From s0 the search walks towards the sign change that r(s0) points to (down if
+    r > 0, up if r < 0, as dr/ds > 0 on stable branches); a local extremum of r met on
+    the way means the branch of s0 has ended at a fold (a jump).
+    """
+    r0, d0, re, im = _residual(s0, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights)
+    if abs(r0) < tol:
+        return s0, False, re, im
+    direction = -1.0 if r0 > 0.0 else 1.0
+    # Newton guess (if it points the right way) sets the first step
+    step = 0.02
+    if d0 > 0.0:
+        step = min(max(abs(r0 / d0), 1e-6), 0.25)
+    a = s0
+    ra = r0
+    rprev = r0
+    jumped = False
+    b = a
+    rb = ra
+    for _ in range(200):
+        b = a + direction * step
+        rb, db, re, im = _residual(b, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights)
+        if rb * ra <= 0.0:
+            break
+        if abs(rb) > abs(rprev):  # moving away from zero: r turned at an extremum, the branch is gone
+            jumped = True
+        rprev = rb
+        a = b
+        ra = rb
+        step = min(step * 1.6, 0.5)
+    # bracket [a, b] (unordered): safeguarded Newton
+    lo, hi = (a, b) if a < b else (b, a)
+    rlo = ra if a < b else rb
+    s = b if abs(rb) < abs(ra) else a
+    for _ in range(100):
+        r, dr, re, im = _residual(s, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights)
+        if abs(r) < tol:
+            return s, jumped, re, im
+        if (r < 0.0) == (rlo < 0.0):
+            lo = s
+            rlo = r
+        else:
+            hi = s
+        sn = s - r / dr if dr != 0.0 else 0.5 * (lo + hi)
+        if not (lo < sn < hi):
+            sn = 0.5 * (lo + hi)
+        if hi - lo < tol:
+            break
+        s = sn
+    r, dr, re, im = _residual(s, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights)
+    return s, jumped, re, im
+
+
+@njit(cache=True, parallel=True)
+def solve(w, mu_re, mu_im, logB, s_start, order, kp, c, KT, R, chi, phimax, S, J1, k3, c2,
+          nodes, weights, tol, s_out, jump_out, kre_out, kim_out):
+    """Amplitudes s = log q (P, N) by continuation along `order` for every parameter set.
+
+    w (N,) rad/s; mu_re, mu_im, logB (P, N); s_start (P,) a guess for the first
+    frequency (below every branch for an up sweep's low end, see `envelope`); parameter
+    arrays (P,). Writes s_out, jump_out and the joint DOF's dynamic stiffness at the
+    solution (kre_out + i kim_out, lbf/in), all (P, N).
+    """
+    P = mu_re.shape[0]
+    N = w.shape[0]
+    for p in prange(P):
+        s = s_start[p]
+        s_prev = s
+        for jj in range(N):
+            n = order[jj]
+            guess = s
+            if jj >= 2:  # continue the branch by linear extrapolation in frequency
+                n1 = order[jj - 1]
+                n2 = order[jj - 2]
+                if w[n1] != w[n2]:
+                    guess = s + (s - s_prev) * (w[n] - w[n1]) / (w[n1] - w[n2])
+            s_prev = s
+            s, jumped, re, im = _root(guess, w[n], mu_re[p, n], mu_im[p, n], logB[p, n], kp[p], c[p], KT[p], R[p],
+                                      chi[p], phimax[p], S[p], J1[p], k3[p], c2[p], nodes, weights, tol)
+            s_out[p, n] = s
+            jump_out[p, n] = jumped and jj > 0
+            kre_out[p, n] = re
+            kim_out[p, n] = im

@@ -1,0 +1,192 @@
+"""Steady-state envelope of a swept-sine test: the first-harmonic (describing-function) model.
+
+At each drive frequency f the base acceleration is a_b = A cos(omega t) and the joint
+moves as z = Re(Z e^{i omega t}), |Z| = q. Every nonlinear element of the joint DOF is
+replaced by its describing function at q (PHYSICS.md):
+
+* Iwan joint (eqs. 3.3-3.7): in-phase stiffness KT - R q^(chi+1) J - S (1 - g(phi_max/q))
+  (the last term past macroslip) and energy-equivalent damping, i omega c_eq with
+  omega c_eq = D(q) / (pi q^2);
+* cubic spring k3 z^3: + 3/4 k3 q^2;  quadratic damper c2 z'|z'|: omega c_eq = 8 c2 omega^2 q / (3 pi);
+* linear spring k and dashpot c = 2 zeta_v sqrt((k + KT) m).
+
+The structure around the joint DOF is linear and exact: on a rigid base
+Z = -m A / (K_z(q) - m omega^2); with the flexible fixture (`Fixture`, coordinates of
+`state_space`) the can's DOF is condensed exactly, Z = -gamma m A / (K_z(q) - mu) with a
+complex effective inertia mu and base-load factor gamma. So q solves the scalar fixed
+point q = |gamma| m A / |K_z(q) - mu|, up to three solutions near a softening fold (two
+stable). The measured channel is the slug's absolute acceleration through the sensor:
+T = gain * (1 - omega^2 (W + Z) / A) * exp(-i omega tau).
+
+Every named effect of `MinistackModel` enters here and in the time integrator from the
+same fields: a new effect is a field of the model, a term in `_stiffness` (nonlinear,
+joint DOF) or in `_structure_terms` (linear structure, sensor), and a term in
+`_integrator`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from . import _envelope_kernel as _k
+from .amplitude import G, _J
+from .iwan import derived
+from .structure import MinistackModel
+
+__all__ = ["SteadyState", "steady_state"]
+
+_NODES, _WEIGHTS = np.polynomial.legendre.leggauss(16)
+_NODES = 0.5 * (_NODES + 1.0)
+_WEIGHTS = 0.5 * _WEIGHTS
+TOL = 1e-12  # convergence of s = log q: 1e-12 relative in amplitude
+
+
+@dataclass(frozen=True)
+class SteadyState:
+    """Steady-state first-harmonic response along a sweep.
+
+    Attributes
+    ----------
+    transmissibility : ndarray of complex, shape (..., N)
+        Measured response channel over base acceleration (sensor gain and delay
+        applied), the envelope a swept-sine test shows (dimensionless).
+    relative : ndarray of complex, shape (..., N)
+        Joint relative displacement Z (in) per unit phase of the base acceleration
+        (z = Re(Z e^{i omega t}) when a_b = A cos(omega t)).
+    q_in : ndarray, shape (..., N)
+        Joint amplitude |Z|, in.
+    jump : ndarray of bool, shape (..., N)
+        True at the first frequency (in sweep order) after the followed branch ended
+        at a fold: the response jumps there.
+    """
+
+    transmissibility: NDArray[np.complex128]
+    relative: NDArray[np.complex128]
+    q_in: NDArray[np.float64]
+    jump: NDArray[np.bool_]
+
+
+def _field(value, shape) -> NDArray[np.float64]:
+    """A model field broadcast to the parameter batch (P,) (constant along frequency)."""
+    a = np.broadcast_to(np.asarray(value, dtype=float), shape)
+    return np.ascontiguousarray(a.reshape(-1, shape[-1])[:, 0])
+
+
+def _structure_terms(model: MinistackModel, w: NDArray, shape) -> tuple[NDArray, NDArray]:
+    """Effective inertia mu (P, N) and base-load factor gamma (P, N) seen by the joint DOF.
+
+    Rigid base: mu = m omega^2, gamma = 1. Fixture (can DOF w = x_can - x_base between the
+    base and the joint; M = [[m_can + m, m], [m, m]], K = diag(k_can, K_z)): condensing
+    the can's row, a11 = k_can + i omega c_can - omega^2 (m_can + m), gives
+    mu = omega^2 m (1 + omega^2 m / a11) and gamma = (k_can + i omega c_can) / a11.
+    """
+    m = _field(model.m, shape)[:, None]
+    if model.fixture is None:
+        return m * w**2 + 0j, np.ones((m.shape[0], w.size), complex)
+    fx = model.fixture
+    m_can = _field(fx.m_can, shape)[:, None]
+    k_can = m_can * (2 * np.pi * _field(fx.f_can, shape)[:, None]) ** 2
+    c_can = 2.0 * _field(fx.zeta_can, shape)[:, None] * np.sqrt(k_can * m_can)
+    kc = k_can + 1j * w * c_can
+    a11 = kc - w**2 * (m_can + m)
+    return w**2 * m * (1.0 + w**2 * m / a11), kc / a11
+
+
+def steady_state(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike = 1.0, *,
+                 direction: Literal["up", "down"] = "up") -> SteadyState:
+    """Steady-state first-harmonic response of a base-excited model along a sweep.
+
+    Parameters
+    ----------
+    model : MinistackModel
+        Structure, joint and named effects. Its numeric fields (and those of its
+        `IwanParams` and `Fixture`) may be arrays of shape (P, 1) (or (P1, P2, 1), ...)
+        to evaluate P parameter sets at once; they must not vary along the last
+        (frequency) axis.
+    f_hz : array_like, shape (N,)
+        Drive frequencies, Hz (> 0), in any order; the sweep order is set by `direction`.
+    base_g : float or array_like, shape (N,)
+        Base-acceleration amplitude at each frequency, g (e.g. the measured base envelope).
+    direction : {'up', 'down'}
+        Sweep direction: where the response has several stable amplitudes, the one a
+        sweep reaches, i.e. the branch continued from the sweep's start until it ends
+        at a fold (flagged in `jump`).
+
+    Returns
+    -------
+    SteadyState
+        Arrays of shape broadcast(parameter shape, (N,)).
+
+    Notes
+    -----
+    Each amplitude solves the fixed point to 1e-12 in log q (bracketed Newton,
+    continued from the neighbouring frequency), so it is an exact describing-function
+    solution, not a grid value; dashpot convention as `harmonic_balance(viscous="dashpot")`.
+    """
+    if direction not in ("up", "down"):
+        raise ValueError(f"direction must be 'up' or 'down', got {direction!r}.")
+    f = np.atleast_1d(np.asarray(f_hz, dtype=float))
+    if f.ndim != 1 or not np.all(np.isfinite(f) & (f > 0)):
+        raise ValueError("steady_state: f_hz must be a 1-D array of positive, finite frequencies in Hz.")
+    A = np.broadcast_to(np.asarray(base_g, dtype=float), f.shape) * G
+    if not np.all(np.isfinite(A) & (A > 0)):
+        raise ValueError("steady_state: base_g must be positive and finite (g) at every frequency.")
+    iw = model.iwan
+    fields = [model.m, model.k, model.zeta_v, model.k3, model.c2, model.sensor_gain, model.sensor_delay_s]
+    if iw is not None:
+        fields += [iw.Fs, iw.KT, iw.chi, iw.beta]
+    if model.fixture is not None:
+        fields += [model.fixture.m_can, model.fixture.f_can, model.fixture.zeta_can]
+    shape = np.broadcast_shapes(*(np.shape(v) for v in fields), f.shape)
+    out_shape = shape
+    shape = (int(np.prod(shape[:-1], dtype=int)), shape[-1])
+    P = shape[0]
+    w = 2 * np.pi * f
+    m, k, zv = (_field(v, shape) for v in (model.m, model.k, model.zeta_v))
+    k3, c2 = _field(model.k3, shape), _field(model.c2, shape)
+    if iw is None:
+        KT = np.zeros(P)
+        R = S = J1 = np.zeros(P)
+        chi = np.full(P, -0.5)
+        phimax = np.ones(P)
+    else:
+        Fs, KT, chi, beta = (_field(v, shape) for v in (iw.Fs, iw.KT, iw.chi, iw.beta))
+        phimax, R, S = derived(Fs, KT, chi, beta)
+        J1 = _J(chi, np.ones_like(chi))
+    c = 2.0 * zv * np.sqrt((k + KT) * m)
+    mu, gamma = _structure_terms(model, w, shape)
+    logB = np.log(np.abs(gamma) * m[:, None] * A)
+    order = np.argsort(f, kind="stable")
+    if direction == "down":
+        order = order[::-1]
+    n0 = order[0]
+    stuck = k + KT + 1j * w[n0] * c
+    s0 = np.log(np.abs(gamma[:, n0]) * m * A[n0] / np.abs(stuck - mu[:, n0]))
+    s = np.empty((P, f.size))
+    jump = np.zeros((P, f.size), dtype=np.bool_)
+    kre, kim = np.empty((P, f.size)), np.empty((P, f.size))
+    _k.solve(w, np.ascontiguousarray(mu.real), np.ascontiguousarray(mu.imag), np.ascontiguousarray(logB), s0,
+             order.astype(np.int64), k, c, KT, R, chi, phimax, S, J1, k3, c2, _NODES, _WEIGHTS, TOL, s, jump,
+             kre, kim)
+    q = np.exp(s)
+    Kz = kre + 1j * kim
+    Z = -gamma * m[:, None] * A / (Kz - mu)
+    # absolute slug acceleration: a_b - omega^2 (W + Z); the can's motion W from its row
+    if model.fixture is None:
+        W = 0.0
+    else:
+        fx = model.fixture
+        m_can = _field(fx.m_can, shape)[:, None]
+        k_can = m_can * (2 * np.pi * _field(fx.f_can, shape)[:, None]) ** 2
+        c_can = 2.0 * _field(fx.zeta_can, shape)[:, None] * np.sqrt(k_can * m_can)
+        a11 = k_can + 1j * w * c_can - w**2 * (m_can + m[:, None])
+        W = (-(m_can + m[:, None]) * A + w**2 * m[:, None] * Z) / a11  # can row: a11 W - omega^2 m Z = -(m_can+m) A
+    T = 1.0 - w**2 * (W + Z) / A
+    gain = _field(model.sensor_gain, shape)[:, None]
+    tau = _field(model.sensor_delay_s, shape)[:, None]
+    T = gain * T * np.exp(-1j * w * tau)
+    return SteadyState(T.reshape(out_shape), Z.reshape(out_shape), q.reshape(out_shape), jump.reshape(out_shape))
+
