@@ -86,8 +86,12 @@ class Validation:
 def _one_run(model: MinistackModel, record: pd.DataFrame, row: dict, draws: Sequence[MinistackModel],
              s: ValidateSettings, envelopes_kw: dict | None, modal_kw: dict | None):
     t0 = time.perf_counter()
-    (env_m, meta_m, props_m), (env_s, _, props_s) = measure_pair(model, record, row, envelopes_kw=envelopes_kw,
-                                                                 modal_kw=modal_kw)
+    try:
+        (env_m, meta_m, props_m), (env_s, _, props_s) = measure_pair(model, record, row, envelopes_kw=envelopes_kw,
+                                                                     modal_kw=modal_kw)
+    except ValueError as exc:  # a record the envelopes cannot process: reported, the other runs go on
+        head = {k: row[k] for k in ("run_id", "assembly", "sequence", "level_g", "direction") if k in row}
+        return pd.DataFrame(), {**head, "n_frames": 0, "note": str(exc)}
     t1 = time.perf_counter()
     frames, metrics = compare_run(env_m, props_m, env_s, props_s, band=s.band)
     t2 = time.perf_counter()
