@@ -135,3 +135,43 @@ def test_E_of_the_calibrated_model_is_at_the_noise_floor_and_grows_with_a_hidden
           f"{v_gain.error['E']:.2f}\n{v_gain.words}")
     assert e_cal <= 1.5 * e_true
     assert v_gain.error["E"] >= 3 * e_cal
+
+
+@pytest.mark.slow
+def test_workflow_validate_stage_reruns_only_itself_on_a_config_edit(tmp_path, small_campaign):
+    """`snakemake validate` on a copy of the small campaign; then -n: nothing; an edit of validate: only it."""
+    import shutil
+    import subprocess
+    import sys
+
+    import yaml
+    from _campaign import REPO
+
+    work = tmp_path / "wf"
+    work.mkdir()
+    shutil.copy(REPO / "Snakefile", work)
+    for folder in ("workflow", "profiles"):
+        shutil.copytree(REPO / folder, work / folder, ignore=shutil.ignore_patterns("__pycache__"))
+    small = {"calibrate": {"population": 40, "offspring": 40, "generations": 6, "n_polish": 1},
+             "posterior": {"max_steps": 400, "chunk": 200}, "validate": {"n_draws": 2}}
+    (work / "small.yaml").write_text(yaml.safe_dump(small))
+    out = tmp_path / "results"
+
+    def smk(*args):
+        return subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", "--configfile", "small.yaml",
+                               "--config", f"raw_data={small_campaign}", f"results={out}", *args], cwd=work,
+                              capture_output=True, text=True, timeout=600)
+
+    res = smk("validate")
+    assert res.returncode == 0, res.stderr
+    summary = json.loads((out / "validation" / "first" / "summary.json").read_text())
+    assert np.isfinite(summary["E"]) and "peak response" in summary["words"]
+    metrics = pd.read_csv(out / "validation" / "first" / "metrics.csv")
+    assert len(metrics) == 5 and (metrics["n_frames"] > 0).all()
+    assert (out / "figures" / "fig3_11_validation.png").stat().st_size > 10_000
+    assert "validation envelope error E" in (out / "logs" / "validate" / "first.log").read_text()
+    assert "Nothing to be done" in smk("-n", "validate").stdout
+    small["validate"]["n_draws"] = 3
+    (work / "small.yaml").write_text(yaml.safe_dump(small))
+    dry = smk("-n", "validate").stdout
+    assert "validate_assembly" in dry and "calibrate_assembly" not in dry and "posterior_assembly" not in dry
