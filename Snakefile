@@ -5,6 +5,7 @@
 #   modal      resonance, damping, scatter, figures, FRFs    -> <results>/modal/modal_properties.csv, frf/
 #   calibrate  GA (DEAP) on eq. 3.9 per assembly + polish     -> <results>/calibration/<assembly>/ga_best.json
 #   posterior  emcee around the optimum, Table 3.2, Fig. 3.8  -> <results>/posterior/<assembly>/summary.csv
+#   validate   model driven by the measured base, Fig. 3.11   -> <results>/validation/<assembly>/summary.json
 #
 # Everything:      snakemake --cores 2      (a bare `snakemake` uses profiles/default/)
 # One stage:       snakemake --cores 2 ingest
@@ -27,6 +28,7 @@ include: "workflow/rules/envelopes.smk"
 include: "workflow/rules/modal.smk"
 include: "workflow/rules/calibrate.smk"
 include: "workflow/rules/posterior.smk"
+include: "workflow/rules/validate.smk"
 
 
 rule all:
@@ -36,3 +38,4 @@ rule all:
         rules.modal.input,
         rules.calibrate.input,
         rules.posterior.input,
+        rules.validate.input,

@@ -1,0 +1,181 @@
+"""The validation envelope error E of an assembly, its repeat-scatter scale, and the misfit in words.
+
+E is defined in `envelope_error`. Its scale is the measured repeat-to-repeat scatter
+(`repeat_scatter`): what the same test gives twice is the resolution below which no
+model can be judged.
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import pandas as pd
+
+__all__ = ["BINS", "repeat_scatter", "envelope_error", "describe_misfit"]
+
+BINS = (0.0, 1.0, 3.0, np.inf)  # |x| = |f/f_res - 1| / zeta: within half-power, flanks, far
+
+
+def _offset(f: np.ndarray, f_res: float, zeta: float) -> np.ndarray:
+    """x = (f/f_res - 1)/zeta: distance from resonance in half-power half-widths."""
+    return (f / f_res - 1.0) / zeta
+
+
+def _bin(x: np.ndarray) -> np.ndarray:
+    return np.clip(np.digitize(np.abs(x), BINS[1:-1]), 0, len(BINS) - 2)
+
+
+def repeat_scatter(frames: Mapping[str, pd.DataFrame], metrics: pd.DataFrame, *, floor_db: float = 0.05,
+                   floor_deg: float = 0.3, n_grid: int = 200) -> pd.DataFrame:
+    """Measured repeat-to-repeat scatter of the transmissibility's magnitude (dB) and phase (deg).
+
+    Runs at the same level and direction with at least two usable runs form a group. Each
+    run's measured magnitude and phase are interpolated onto a common grid of ``n_grid``
+    frequencies over the band all the group's runs share; their sample standard deviation
+    (ddof 1) at each grid point is binned by the distance from the group's mean
+    resonance, |x| = |f/f_res - 1|/zeta in `BINS` (within the half-power band, its flanks,
+    far), and pooled over groups (dof-weighted mean of variances). Each bin's scale is the
+    pooled standard deviation, never less than the floor (``floor_db``, ``floor_deg``);
+    a bin without repeats (a campaign without repeated runs) takes the largest pooled value
+    of the other bins or, if none, the floor. The floors (0.05 dB = 0.6%, 0.3 deg) are
+    about what a back-to-back accelerometer pair resolves.
+
+    Parameters
+    ----------
+    frames : mapping run_id -> DataFrame
+        `compare_run` frames (f_hz, mag_meas_db, phase_meas_deg, in_band).
+    metrics : DataFrame
+        `compare_run` metrics (run_id, level_g, direction, f_res_meas_hz, zeta_meas).
+
+    Returns
+    -------
+    DataFrame, one row per bin
+        x_lo, x_hi, sigma_mag_db, sigma_phase_deg, dof, source ('repeats', 'other bins', 'floor').
+    """
+    ss = np.zeros((len(BINS) - 1, 2))
+    dof = np.zeros(len(BINS) - 1)
+    ok = metrics[metrics["n_frames"] > 0]
+    for _, g in ok.groupby(["level_g", "direction"], sort=True):
+        if len(g) < 2:
+            continue
+        fr = [frames[r][frames[r]["in_band"]] for r in g["run_id"]]
+        lo = max(d["f_hz"].min() for d in fr)
+        hi = min(d["f_hz"].max() for d in fr)
+        if not hi > lo:
+            continue
+        grid = np.linspace(lo, hi, n_grid)
+        vals = []
+        for d in fr:
+            o = np.argsort(d["f_hz"].to_numpy())
+            f = d["f_hz"].to_numpy()[o]
+            vals.append([np.interp(grid, f, d[c].to_numpy()[o]) for c in ("mag_meas_db", "phase_meas_deg")])
+        v = np.asarray(vals)  # (runs, 2, grid)
+        v[:, 1] -= 360.0 * np.round((v[:, 1] - v[:1, 1]).mean(axis=1, keepdims=True) / 360.0)
+        var = np.var(v, axis=0, ddof=1)  # (2, grid)
+        b = _bin(_offset(grid, g["f_res_meas_hz"].mean(), g["zeta_meas"].mean()))
+        for k in range(len(BINS) - 1):
+            sel = b == k
+            if sel.any():
+                ss[k] += var[:, sel].mean(axis=1) * (len(g) - 1)
+                dof[k] += len(g) - 1
+    rows = []
+    pooled = np.where(dof[:, None] > 0, np.sqrt(ss / np.maximum(dof, 1)[:, None]), np.nan)
+    for k in range(len(BINS) - 1):
+        if dof[k] > 0:
+            s, src = pooled[k], "repeats"
+        elif np.isfinite(pooled).any():
+            s, src = np.nanmax(pooled, axis=0), "other bins"
+        else:
+            s, src = np.array([0.0, 0.0]), "floor"
+        rows.append(dict(x_lo=BINS[k], x_hi=BINS[k + 1], sigma_mag_db=max(float(s[0]), floor_db),
+                         sigma_phase_deg=max(float(s[1]), floor_deg), dof=int(dof[k]), source=src))
+    return pd.DataFrame(rows)
+
+
+def envelope_error(frames: Mapping[str, pd.DataFrame], metrics: pd.DataFrame, scale: pd.DataFrame) -> dict:
+    """The validation envelope error E of one assembly, and its parts.
+
+    Definition. For every usable run r and every frame j of its band (drive on, neither
+    record bad, full drive, f within the band around the measured resonance), let
+    dM_rj = 20 log10 |T_sim / T_meas| (dB) and dP_rj = arg(T_sim / T_meas) (deg, wrapped to
+    (-180, 180]), with T the transmissibility response/base of the envelopes (the
+    simulation interpolated onto the measured frames' drive frequencies), and let
+    sM, sP be the measured repeat-to-repeat scatter of the same quantities in the frame's
+    bin of |x| = |f/f_res - 1|/zeta (`repeat_scatter`, floored). Then
+
+        E_mag   = sqrt( mean_r mean_j (dM_rj / sM)^2 ),
+        E_phase = sqrt( mean_r mean_j (dP_rj / sP)^2 ),
+        E       = sqrt( (E_mag^2 + E_phase^2) / 2 ),
+
+    each run weighted equally whatever its number of frames. A model whose envelopes
+    differ from the measurement only as much as a repeated test does gives E about 1
+    (a noiseless model against one noisy record: the difference has the per-run
+    scatter); E grows linearly with a systematic misfit. The same means taken over the
+    runs of one level give the per-level values.
+
+    Parameters
+    ----------
+    frames : mapping run_id -> DataFrame
+        `compare_run` frames.
+    metrics : DataFrame
+        `compare_run` metrics (run_id, level_g, n_frames, f_res_meas_hz, zeta_meas).
+    scale : DataFrame
+        `repeat_scatter`'s table.
+
+    Returns
+    -------
+    dict
+        E, E_mag, E_phase, n_runs, per_level {level: {E, E_mag, E_phase, n_runs}},
+        scale (the bins' sigma_mag_db, sigma_phase_deg, source).
+    """
+    sm = scale["sigma_mag_db"].to_numpy()
+    sp = scale["sigma_phase_deg"].to_numpy()
+    per_run = []
+    for r in metrics[metrics["n_frames"] > 0].itertuples(index=False):
+        d = frames[r.run_id]
+        d = d[d["in_band"]]
+        b = _bin(_offset(d["f_hz"].to_numpy(), r.f_res_meas_hz, r.zeta_meas))
+        per_run.append((r.level_g, np.mean((d["d_mag_db"].to_numpy() / sm[b]) ** 2),
+                        np.mean((d["d_phase_deg"].to_numpy() / sp[b]) ** 2)))
+    if not per_run:
+        raise ValueError("no usable run to validate: every run is unusable or has no frame in the band.")
+    t = pd.DataFrame(per_run, columns=["level", "m2", "p2"])
+
+    def parts(g: pd.DataFrame) -> dict:
+        em, ep = float(np.sqrt(g["m2"].mean())), float(np.sqrt(g["p2"].mean()))
+        return dict(E=float(np.sqrt((em**2 + ep**2) / 2)), E_mag=em, E_phase=ep, n_runs=int(len(g)))
+
+    out = parts(t)
+    out["per_level"] = {f"{lev:g}": parts(g) for lev, g in t.groupby("level", sort=True)}
+    out["scale"] = scale.to_dict(orient="records")
+    return out
+
+
+def _pct(x: float) -> str:
+    return f"{abs(x) * 100:.1f}%"
+
+
+def describe_misfit(metrics: pd.DataFrame, err: Mapping, *, level_unit: str = "g") -> str:
+    """The misfit in plain words: E, peak amplitude, resonance, damping, far below resonance."""
+    m = metrics[metrics["n_frames"] > 0]
+    if m.empty:
+        return "no usable run to compare."
+    verdict = ("about as close as a repeated test" if err["E"] <= 2 else
+               "clearly outside the repeat scatter" if err["E"] > 5 else "somewhat outside the repeat scatter")
+    words = [f"validation envelope error E = {err['E']:.2f} (magnitude {err['E_mag']:.2f}, phase "
+             f"{err['E_phase']:.2f}; 1 = the repeat-to-repeat scatter): {verdict}."]
+    pr = float(np.nanmedian(m["peak_ratio"]))
+    words.append(f"The model {'under' if pr < 1 else 'over'}-predicts the peak response by {_pct(pr - 1)} "
+                 f"(median over {len(m)} runs; range {m['peak_ratio'].min():.3f} to {m['peak_ratio'].max():.3f}).")
+    lv = m.groupby("level_g")["f_res_rel_err"].median()
+    same = (np.sign(lv) == np.sign(lv.median())).all()
+    words.append(f"Its resonance sits {_pct(lv.median())} {'high' if lv.median() > 0 else 'low'} (median"
+                 + (", same sign at every level" if same else "; the sign changes with level")
+                 + "; per level " + ", ".join(f"{k:g} {level_unit}: {v * 100:+.2f}%" for k, v in lv.items()) + ").")
+    zm = float(np.nanmedian(m["zeta_rel_err"]))
+    words.append(f"Its damping is {_pct(zm)} {'above' if zm > 0 else 'below'} the measured (median).")
+    lo = float(np.nanmedian(m["low_freq_ratio"]))
+    if np.isfinite(lo):
+        words.append(f"Far below resonance (f < 0.7 f_res) the measured response is {_pct(1 / lo - 1)} "
+                     f"{'above' if lo < 1 else 'below'} the model's.")
+    return " ".join(words)

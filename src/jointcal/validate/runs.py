@@ -1,0 +1,204 @@
+"""One run simulated with a model driven by its measured base record, and compared with the measurement.
+
+The simulated record keeps the measured base channel exactly as recorded (NaN, DC offset
+and all) and replaces the response channel by the model's, so `jointcal.modal.measure_run`
+sees the same reference channel: the same drive ridge, frames, window and estimators for
+both records, and the processing bias cancels. The model is driven by the base record
+cleaned as `jointcal.signal.envelopes` cleans it (NaN gaps bridged linearly here, since
+the integrator needs a finite input; median removed).
+
+`draw_transmissibility` is the cheaper path for posterior draws (the predictive band
+only, never E): it simulates only the frames of the band (plus a tapered lead-in) and
+demodulates both channels with the drive phase rebuilt from the measured frames'
+drive frequencies and the same Hann window (tested against `measure_run` to 0.02 dB and
+0.1 deg).
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import pandas as pd
+from numpy.typing import NDArray
+from scipy.signal.windows import hann
+
+from ..modal import measure_run
+from ..models import MinistackModel, simulate
+
+__all__ = ["clean_base", "simulate_record", "band_frames", "compare_run", "measure_pair", "draw_transmissibility"]
+
+
+def clean_base(record: pd.DataFrame) -> NDArray[np.float64]:
+    """The base channel (g) as the model's input: NaN/inf bridged linearly, median removed, shape (N,)."""
+    x = record["base_accel_g"].to_numpy(dtype=float).copy()
+    ok = np.isfinite(x)
+    if not ok.any():
+        raise ValueError("the base channel holds no finite sample; the run cannot drive a simulation.")
+    if not ok.all():
+        i = np.arange(x.size)
+        x[~ok] = np.interp(i[~ok], i[ok], x[ok])
+    return x - np.median(x)
+
+
+def simulate_record(model: MinistackModel, record: pd.DataFrame, row: Mapping) -> pd.DataFrame:
+    """The record the model would give: measured time and base columns, simulated response (g).
+
+    Samples where the measured base is not finite are NaN in the simulated response too,
+    so the same frames are left out of both envelopes.
+    """
+    if "base_accel_g" not in record.columns:
+        raise ValueError(f"run {row.get('run_id', '?')}: validation needs a base-driven record (base_accel_g).")
+    y = simulate(model, clean_base(record), float(row["sample_rate_hz"])).response_g
+    y[~np.isfinite(record["base_accel_g"].to_numpy(dtype=float))] = np.nan
+    out = record[["time_s", "base_accel_g"]].copy()
+    out["response_accel_g"] = y
+    return out
+
+
+def _transmissibility(env: pd.DataFrame) -> NDArray[np.complex128]:
+    return ((env["resp_re"] + 1j * env["resp_im"]) / (env["ref_re"] + 1j * env["ref_im"])).to_numpy()
+
+
+def band_frames(env: pd.DataFrame, f_res_hz: float, band: Sequence[float]) -> NDArray[np.bool_]:
+    """Frames compared: drive on, not bad, at full drive (|base| >= 0.8 x median), f in band x f_res."""
+    ref = np.abs((env["ref_re"] + 1j * env["ref_im"]).to_numpy())
+    on = env["drive_on"].to_numpy(bool) & ~env["bad"].to_numpy(bool)
+    full = ref >= 0.8 * np.median(ref[on]) if on.any() else on
+    f = env["f_drive_hz"].to_numpy()
+    return on & full & (f >= band[0] * f_res_hz) & (f <= band[1] * f_res_hz)
+
+
+def _on_grid(f_src: NDArray, T: NDArray, f_dst: NDArray) -> NDArray[np.complex128]:
+    """Complex T(f) interpolated as log-magnitude and unwrapped phase (sorted by f)."""
+    o = np.argsort(f_src, kind="stable")
+    lm = np.interp(f_dst, f_src[o], np.log(np.abs(T[o])))
+    ph = np.interp(f_dst, f_src[o], np.unwrap(np.angle(T[o])))
+    return np.exp(lm + 1j * ph)
+
+
+def _phase_deg(T: NDArray) -> NDArray[np.float64]:
+    """Unwrapped phase (deg) along the frames, anchored so the first frame lies in (-180, 180]."""
+    ph = np.degrees(np.unwrap(np.angle(T)))
+    return ph - 360.0 * np.round(ph[0] / 360.0) if ph.size else ph
+
+
+def compare_run(env_m: pd.DataFrame, props_m: Mapping, env_s: pd.DataFrame, props_s: Mapping, *,
+                band: Sequence[float] = (0.8, 1.2), zeta_key: str = "zeta_phase_resonance"
+                ) -> tuple[pd.DataFrame, dict]:
+    """Measured vs simulated envelope of one run, frame by frame, and the run's metrics.
+
+    Parameters
+    ----------
+    env_m, env_s : DataFrame
+        Envelopes of the measured and simulated records (`jointcal.signal.envelopes`).
+    props_m, props_s : mapping
+        Their modal rows (`jointcal.modal.modal_properties`).
+    band : (lo, hi)
+        Compared band as fractions of the measured resonance frequency f_res_hz.
+    zeta_key : str
+        Damping column compared.
+
+    Returns
+    -------
+    frames : DataFrame, one row per measured frame that is drive-on, not bad and at full drive
+        time_s, f_hz, mag_meas_db, phase_meas_deg, mag_sim_db, phase_sim_deg (of the
+        transmissibility response/base), d_mag_db, d_phase_deg (simulated minus measured),
+        resp_meas_g, resp_sim_g (response envelope), in_band, band_lo_hz, band_hi_hz.
+    metrics : dict
+        One row of metrics.csv (errors in dB, deg, and relative for f_res and zeta).
+    """
+    f_res = float(props_m["f_res_hz"])
+    head = {k: props_m[k] for k in ("run_id", "assembly", "sequence", "level_g", "direction") if k in props_m}
+    if not np.isfinite(f_res) or "unusable" in str(props_m.get("flags", "")):
+        return pd.DataFrame(), {**head, "n_frames": 0, "note": "measured run unusable"}
+    lo, hi = band[0] * f_res, band[1] * f_res
+    use_m = band_frames(env_m, f_res, (0.0, np.inf))
+    use_s = band_frames(env_s, f_res, (0.0, np.inf))
+    f = env_m["f_drive_hz"].to_numpy()[use_m]
+    T_m = _transmissibility(env_m)[use_m]
+    f_s = env_s["f_drive_hz"].to_numpy()[use_s]
+    T_s = _on_grid(f_s, _transmissibility(env_s)[use_s], f)
+    R_s = _on_grid(f_s, (env_s["resp_re"] + 1j * env_s["resp_im"]).to_numpy()[use_s], f)
+    inside = (f >= min(f_s, default=np.inf)) & (f <= max(f_s, default=-np.inf))
+    d = T_s / T_m
+    ph_m = _phase_deg(T_m)
+    d_ph = np.degrees(np.angle(d))  # wrapped to (-180, 180]
+    frames = pd.DataFrame(dict(
+        time_s=env_m["time_s"].to_numpy()[use_m], f_hz=f, mag_meas_db=20 * np.log10(np.abs(T_m)),
+        phase_meas_deg=ph_m, mag_sim_db=20 * np.log10(np.abs(T_s)), phase_sim_deg=ph_m + d_ph,
+        d_mag_db=20 * np.log10(np.abs(d)), d_phase_deg=d_ph,
+        resp_meas_g=np.abs((env_m["resp_re"] + 1j * env_m["resp_im"]).to_numpy()[use_m]), resp_sim_g=np.abs(R_s),
+        in_band=(f >= lo) & (f <= hi) & inside, band_lo_hz=lo, band_hi_hz=hi))
+    b = frames[frames["in_band"]]
+    below = frames[(frames["f_hz"] < 0.7 * f_res) & inside]
+    zm, zs = float(props_m.get(zeta_key, np.nan)), float(props_s.get(zeta_key, np.nan))
+    peak_m = float(b["resp_meas_g"].max()) if len(b) else np.nan
+    peak_s = float(b["resp_sim_g"].max()) if len(b) else np.nan
+    metrics = {**head, "n_frames": int(len(b)), "band_lo_hz": lo, "band_hi_hz": hi,
+               "mag_err_rms_db": float(np.sqrt(np.mean(b["d_mag_db"] ** 2))) if len(b) else np.nan,
+               "mag_err_mean_db": float(b["d_mag_db"].mean()) if len(b) else np.nan,
+               "phase_err_rms_deg": float(np.sqrt(np.mean(b["d_phase_deg"] ** 2))) if len(b) else np.nan,
+               "phase_err_mean_deg": float(b["d_phase_deg"].mean()) if len(b) else np.nan,
+               "peak_meas_g": peak_m, "peak_sim_g": peak_s, "peak_ratio": peak_s / peak_m,
+               "f_res_meas_hz": f_res, "f_res_sim_hz": float(props_s["f_res_hz"]),
+               "f_res_rel_err": float(props_s["f_res_hz"]) / f_res - 1.0,
+               "zeta_meas": zm, "zeta_sim": zs, "zeta_rel_err": zs / zm - 1.0,
+               "low_freq_ratio": float(10 ** (below["d_mag_db"].median() / 20)) if len(below) else np.nan,
+               "flags_meas": props_m.get("flags", ""), "flags_sim": props_s.get("flags", ""), "note": ""}
+    return frames, metrics
+
+
+def measure_pair(model: MinistackModel, record: pd.DataFrame, row: Mapping, measured: tuple | None = None, *,
+                 envelopes_kw: dict | None = None, modal_kw: dict | None = None):
+    """measure_run on the measured record (unless given) and on the model's record: ((env, meta, props) x 2)."""
+    meas = measured if measured is not None else measure_run(record, dict(row), envelopes_kw=envelopes_kw,
+                                                             modal_kw=modal_kw)
+    sim = measure_run(simulate_record(model, record, row), dict(row), envelopes_kw=envelopes_kw, modal_kw=modal_kw)
+    return meas, sim
+
+
+def draw_transmissibility(models: Sequence[MinistackModel], record: pd.DataFrame, env_m: pd.DataFrame,
+                          meta, frames: NDArray[np.bool_], *, lead_s: float = 0.1) -> NDArray[np.complex128]:
+    """Transmissibility response/base of many models on the measured frames `frames` (the cheap path).
+
+    Parameters
+    ----------
+    models : sequence of MinistackModel, length P
+    record : DataFrame
+        The measured run record.
+    env_m : DataFrame
+        Its envelopes; ``meta`` their `EnvelopeMeta` (window, hop, sample rate).
+    frames : ndarray of bool, shape (n_frames,)
+        Frames wanted (a contiguous stretch, e.g. the band).
+    lead_s : float
+        Simulated time before the first frame's window, s; the input rises over its
+        first half with a raised cosine, so the start-up transient has died out.
+
+    Returns
+    -------
+    ndarray, complex, shape (P, frames.sum())
+    """
+    idx = np.flatnonzero(frames)
+    if idx.size == 0:
+        return np.zeros((len(models), 0), complex)
+    fs, n, hop = meta.fs_hz, meta.n_window, int(round(meta.hop_s * meta.fs_hz))
+    base = clean_base(record)
+    lead = int(round(lead_s * fs))
+    s0 = max(0, hop * idx[0] - lead)
+    s1 = min(base.size, hop * idx[-1] + n)
+    x = base[s0:s1].copy()
+    ramp = min(lead // 2, hop * idx[0] - s0)
+    if ramp > 1 and s0 > 0:
+        x[:ramp] *= 0.5 * (1 - np.cos(np.pi * np.arange(ramp) / ramp))
+    t = (s0 + np.arange(x.size)) / fs
+    f_s = np.interp(t, env_m["time_s"].to_numpy(), env_m["f_drive_hz"].to_numpy())
+    carrier = np.exp(-2j * np.pi * np.cumsum(f_s) / fs)
+    win = hann(n, sym=False)
+    starts = hop * idx - s0
+    rows = starts[:, None] + np.arange(n)
+    B = (x * carrier)[rows] @ win
+    out = np.empty((len(models), idx.size), complex)
+    for i, model in enumerate(models):
+        y = simulate(model, x, fs).response_g
+        out[i] = ((y * carrier)[rows] @ win) / B
+    return out

@@ -1,0 +1,60 @@
+# Stage validate: the calibrated model driven by each run's measured base record, through the
+# same envelopes and modal code (jointcal.validate); Fig. 3.11.
+# Include after posterior.smk (uses ASSEMBLY_RE and POSTERIOR).
+import jointcal
+
+VALIDATION = RESULTS / "validation"
+
+
+def assembly_records(wildcards):
+    """The raw records of one assembly's runs."""
+    return [str(RAW_DATA / r["file"]) for r in _manifest_rows() if r.get("assembly") == wildcards.assembly]
+
+
+rule validate_assembly:
+    input:
+        runs=RESULTS / "ingest" / "runs.csv",
+        modal=RESULTS / "modal" / "modal_properties.csv",
+        best=RESULTS / "calibration" / "{assembly}" / "ga_best.json",
+        chain=POSTERIOR / "{assembly}" / "chain.npz",
+        records=assembly_records,
+    output:
+        metrics=VALIDATION / "{assembly}" / "metrics.csv",
+        summary=VALIDATION / "{assembly}" / "summary.json",
+        envelopes=directory(VALIDATION / "{assembly}" / "envelopes"),
+    params:
+        version=jointcal.__version__,
+        validate=config.get("validate", {}),
+        envelopes=config["envelopes"],
+        modal=config["modal"],
+    wildcard_constraints:
+        assembly=ASSEMBLY_RE,
+    threads: 2
+    log:
+        RESULTS / "logs" / "validate" / "{assembly}.log",
+    script:
+        "../scripts/validate.py"
+
+
+rule validate_figures:
+    input:
+        metrics=expand(VALIDATION / "{assembly}" / "metrics.csv", assembly=ASSEMBLIES),
+        summary=expand(VALIDATION / "{assembly}" / "summary.json", assembly=ASSEMBLIES),
+        envelopes=expand(VALIDATION / "{assembly}" / "envelopes", assembly=ASSEMBLIES),
+    output:
+        figure=report(RESULTS / "figures" / "fig3_11_validation.png", caption="../report/fig3_11_validation.rst",
+                      category="Validation"),
+    params:
+        version=jointcal.__version__,
+        assemblies=ASSEMBLIES,
+    threads: 1
+    log:
+        RESULTS / "logs" / "validate_figures.log",
+    script:
+        "../scripts/validate_figures.py"
+
+
+rule validate:
+    input:
+        expand(VALIDATION / "{assembly}" / "summary.json", assembly=ASSEMBLIES),
+        rules.validate_figures.output,

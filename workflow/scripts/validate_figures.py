@@ -1,0 +1,23 @@
+"""Snakemake script of rule ``validate_figures``: Fig. 3.11 from the validation tables.
+
+(No ``from __future__``: Snakemake prepends a preamble to scripts.)
+"""
+import json
+from pathlib import Path
+
+import pandas as pd
+
+from jointcal.io import write_bytes_atomic
+from jointcal.report.validation import validation_figure
+
+
+def main(smk) -> None:
+    names = list(smk.params.assemblies)
+    metrics = {a: pd.read_csv(p) for a, p in zip(names, smk.input.metrics)}
+    errors = {a: json.loads(Path(p).read_text())["E"] for a, p in zip(names, smk.input.summary)}
+    frames = {a: {p.stem: pd.read_csv(p) for p in sorted(Path(d).glob("*.csv"))} for a, d in zip(names, smk.input.envelopes)}
+    write_bytes_atomic(validation_figure(frames, metrics, errors), smk.output.figure)
+    Path(smk.log[0]).write_text("".join(f"jointcal: {a}: E = {e:.2f}\n" for a, e in errors.items()))
+
+
+main(snakemake)  # noqa: F821 (provided by Snakemake)
