@@ -2,18 +2,21 @@
 
 Modules: `coords` (sampler coordinates aligned with the identifiable combinations),
 `likelihood` (vectorised log-posterior), `sampler` (emcee in chunks to 50 tau,
-resumable), `summary` (tables, sentences, predictive band), `settings` (the
+resumable, with an early stop when 50 tau is out of reach), `modes` (separated modes of the
+draws), `summary` (tables, sentences, predictive band), `settings` (the
 ``posterior:`` config section) and `stage` (files).
 """
 from .coords import Y_NAMES, log_det_dy_dx, x_to_y, y_to_x
 from .likelihood import LogPosterior
-from .sampler import ChainResult, run_chain
+from .modes import find_modes, mode_labels, modes_text
+from .sampler import ChainResult, projected_steps, run_chain
 from .settings import PosteriorSettings
-from .stage import OUTPUTS, run_posterior, start_ball
+from .stage import OUTPUTS, goodness_of_fit, run_posterior, start_ball
 from .summary import NAMES, burn_in, constraints_text, predictive_band, summarize
 
 __all__ = [
-    "Y_NAMES", "x_to_y", "y_to_x", "log_det_dy_dx", "LogPosterior", "ChainResult", "run_chain",
+    "Y_NAMES", "x_to_y", "y_to_x", "log_det_dy_dx", "LogPosterior", "ChainResult", "run_chain", "projected_steps",
+    "find_modes", "mode_labels", "modes_text", "goodness_of_fit",
     "PosteriorSettings", "OUTPUTS", "run_posterior", "start_ball",
     "NAMES", "burn_in", "summarize", "constraints_text", "predictive_band",
 ]

@@ -7,6 +7,15 @@ processes too). The run stops when the chain is longer than ``tau_factor * max(t
 and every tau changed by less than ``tau_rtol`` since the previous chunk, or at
 ``max_steps``.
 
+Early stop (``stop_projected``): a chain whose autocorrelation time keeps growing with
+its length (walkers that do not mix, e.g. between separated modes) never reaches the
+50-tau rule. After ``min_chunks`` checks, the chain length in units of tau, r = N / tau,
+is extrapolated linearly over the last three checks to the N where it reaches
+``tau_factor`` (`projected_steps`). For a chain that mixes, tau settles and r grows at
+1/tau per step, so the projection is about tau_factor * tau; for one that does not, r
+stays flat and the projection runs off. When it exceeds ``stop_projected * max_steps``
+at two checks in a row, the run stops there and says so (``stop_reason``).
+
 Reproducible: emcee draws from its own ``numpy.random.RandomState``, set from `seed`
 through the initial `emcee.State` (not from numpy's global state). Resumable: after
 every chunk `on_chunk` receives the chain so far, the last log-probabilities and the
@@ -23,7 +32,7 @@ import emcee
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["ChainResult", "run_chain", "random_state_arrays", "random_state_tuple"]
+__all__ = ["ChainResult", "run_chain", "projected_steps", "random_state_arrays", "random_state_tuple"]
 
 
 @dataclass
@@ -34,7 +43,10 @@ class ChainResult:
     tau : ndarray (ndim [+ k],) -- integrated autocorrelation time of each coordinate
     (and observed quantity), steps; tau_history : ndarray (chunks, 1 + len(tau)) -- chain
     length, then tau, after each chunk;
-    converged : bool -- the 50-tau rule was met; acceptance : ndarray (walkers,) --
+    converged : bool -- the 50-tau rule was met; stop_reason : str -- "converged",
+    "max_steps" or "projected" (stopped early, see the module notes); projected_steps :
+    float -- the last projection of the steps the 50-tau rule needs (inf: r not growing);
+    acceptance : ndarray (walkers,) --
     acceptance fraction over the whole chain; random_state : tuple -- emcee's RandomState.
     """
 
@@ -45,6 +57,8 @@ class ChainResult:
     converged: bool
     acceptance: NDArray[np.float64]
     random_state: tuple
+    stop_reason: str = "max_steps"
+    projected_steps: float = float("nan")
 
     @property
     def steps(self) -> int:
@@ -71,8 +85,38 @@ def _tau(chain: NDArray[np.float64], observe: Callable | None) -> NDArray[np.flo
     return emcee.autocorr.integrated_time(chain, tol=0)
 
 
+def projected_steps(hist: NDArray[np.float64] | list, tau_factor: float = 50.0, last: int = 3) -> float:
+    """Chain length at which N / max(tau) reaches `tau_factor`, extrapolated linearly over the last checks.
+
+    Parameters
+    ----------
+    hist : array_like, shape (checks, 1 + n)
+        Chain length, then tau of each quantity, after each check (`ChainResult.tau_history`).
+    tau_factor : float
+        Target chain length in units of the largest tau.
+    last : int
+        Checks the linear fit uses.
+
+    Returns
+    -------
+    float
+        Steps; the current length when already there; inf when N / tau is not growing;
+        NaN with fewer than `last` checks.
+    """
+    h = np.asarray(hist, dtype=float).reshape(len(hist), -1)
+    if len(h) < last:
+        return float("nan")
+    n = h[-last:, 0]
+    r = n / np.max(h[-last:, 1:], axis=1)
+    if r[-1] >= tau_factor:
+        return float(n[-1])
+    slope = np.polyfit(n, r, 1)[0]
+    return float(n[-1] + (tau_factor - r[-1]) / slope) if slope > 0 else float("inf")
+
+
 def run_chain(log_prob: Callable[[NDArray[np.float64]], NDArray[np.float64]], x0: NDArray[np.float64], *,
               seed: int, max_steps: int, chunk: int = 1000, tau_factor: float = 50.0, tau_rtol: float = 0.05,
+              stop_projected: float = 0.0, min_chunks: int = 5,
               observe: Callable[[NDArray[np.float64]], NDArray[np.float64]] | None = None,
               resume: dict[str, Any] | None = None,
               on_chunk: Callable[[dict[str, Any]], None] | None = None) -> ChainResult:
@@ -92,6 +136,12 @@ def run_chain(log_prob: Callable[[NDArray[np.float64]], NDArray[np.float64]], x0
         Steps between convergence checks and `on_chunk` calls.
     tau_factor, tau_rtol : float
         Stop when steps > tau_factor * max(tau) and max |delta tau / tau| < tau_rtol.
+    stop_projected : float
+        Stop early when `projected_steps` exceeds ``stop_projected * max_steps`` at two
+        checks in a row, from check `min_chunks` on (0: never; the run goes to max_steps).
+    min_chunks : int
+        Checks before the early stop is considered (tau of a short chain is capped by its
+        length, so N / tau starts flat even for a chain that mixes).
     observe : callable, optional
         ``observe(chain) -> (steps, walkers, k)``: further quantities (e.g. the
         physical parameters) whose tau also counts in the stopping rule; tau then has
@@ -120,7 +170,15 @@ def run_chain(log_prob: Callable[[NDArray[np.float64]], NDArray[np.float64]], x0
     sampler = emcee.EnsembleSampler(nwalkers, ndim, log_prob, vectorize=True)
     tau = _tau(chain, observe) if len(chain) else np.full(ndim, np.inf)
     converged = _converged(hist, tau_factor, tau_rtol)
-    while not converged and len(chain) < max_steps:
+
+    def late(h: list) -> bool:
+        return stop_projected > 0 and len(h) >= min_chunks and projected_steps(h, tau_factor) > stop_projected * max_steps
+
+    hopeless = 0
+    for k in range(1, len(hist) + 1):  # a resumed chain stops where the uninterrupted one would
+        hopeless = hopeless + 1 if late(hist[:k]) else 0
+    projected = projected_steps(hist, tau_factor) if hist else float("nan")
+    while not converged and len(chain) < max_steps and hopeless < 2:
         n = int(min(chunk, max_steps - len(chain)))
         sampler.reset()
         state = sampler.run_mcmc(state, n, skip_initial_state_check=len(chain) > 0)
@@ -130,12 +188,16 @@ def run_chain(log_prob: Callable[[NDArray[np.float64]], NDArray[np.float64]], x0
         tau = _tau(chain, observe)
         hist.append(np.r_[len(chain), tau])
         converged = _converged(hist, tau_factor, tau_rtol)
+        projected = projected_steps(hist, tau_factor)
+        hopeless = hopeless + 1 if late(hist) else 0
         if on_chunk is not None:
             on_chunk(dict(chain=chain, log_prob=lp, random_state=state.random_state, tau_history=hist,
                           accepted=accepted))
     rs = state.random_state if state.random_state is not None else sampler.random_state
+    reason = "converged" if converged else ("projected" if hopeless >= 2 and len(chain) < max_steps else "max_steps")
     return ChainResult(chain=chain, log_prob=lp, tau=tau, tau_history=np.asarray(hist).reshape(len(hist), -1),
-                       converged=converged, acceptance=accepted / max(len(chain), 1), random_state=rs)
+                       converged=converged, acceptance=accepted / max(len(chain), 1), random_state=rs,
+                       stop_reason=reason, projected_steps=projected)
 
 
 def _converged(hist: list[NDArray[np.float64]], tau_factor: float, tau_rtol: float) -> bool:

@@ -21,7 +21,10 @@ class PosteriorSettings:
     seed : seeds emcee's RandomState and the initial ball; n_walkers : walkers (>= 2 * 8);
     max_steps : hard cap on the chain length, steps; chunk : steps between convergence
     checks and checkpoints; tau_factor, tau_rtol : stop when the chain is longer than
-    tau_factor * max(tau) and tau moved by less than tau_rtol; burn_tau : burn-in
+    tau_factor * max(tau) and tau moved by less than tau_rtol; stop_projected : stop early
+    when the chain length tau_factor * tau needs, extrapolated from the running tau, exceeds
+    stop_projected * max_steps at two checks in a row (0: never); min_chunks : checks before
+    that is considered; burn_tau : burn-in
     discarded, in units of max(tau); ball : standard deviation of the initial ball around
     the GA optimum, as a fraction of each prior width; rel_std_floor : smallest relative
     noise of frequency and damping (used when the pooled scatter is missing, zero or
@@ -36,6 +39,8 @@ class PosteriorSettings:
     chunk: int = 1000
     tau_factor: float = 50.0
     tau_rtol: float = 0.05
+    stop_projected: float = 1.5
+    min_chunks: int = 5
     burn_tau: float = 5.0
     ball: float = 1.0e-3
     rel_std_floor: Mapping[str, float] = field(default_factory=lambda: {"frequency": 1.0e-4, "damping": 0.01})
@@ -48,6 +53,9 @@ class PosteriorSettings:
             raise ValueError(f"posterior.n_walkers must be even and >= 16 (2 x 8 coordinates), got {self.n_walkers}")
         if self.max_steps < 1 or self.chunk < 1:
             raise ValueError("posterior.max_steps and posterior.chunk must be >= 1")
+        if self.stop_projected < 0 or self.min_chunks < 3:
+            raise ValueError(f"posterior.stop_projected must be >= 0 and posterior.min_chunks >= 3, got "
+                             f"{self.stop_projected} and {self.min_chunks}")
         if not 0 < self.ball < 0.1:
             raise ValueError(f"posterior.ball must lie in (0, 0.1), got {self.ball}")
         for name in ("rel_std_floor", "noise_max"):

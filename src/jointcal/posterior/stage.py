@@ -8,8 +8,12 @@ Outputs in ``out_dir`` (all written atomically):
   ``log_prob`` (steps, walkers), ``samples`` (draws, 8): burned-in, thinned draws of
   (Fs, KT, chi, beta, k, zeta_v, sigma_f, sigma_zeta) in physical units (``sample_names``),
   ``tau_history`` (chunks, 1 + n): chain length then tau, ``q_ref`` (in), ``burn``,
-  ``converged`` and emcee's RandomState (``rs_*``);
-* ``constraints.txt`` -- convergence, then one sentence per parameter and correlation;
+  ``converged``, ``stop_reason`` ("converged", "max_steps" or "projected"),
+  ``projected_steps``, ``sample_mode`` (the separated mode of each draw, 0 = heaviest,
+  `jointcal.posterior.modes`), ``fit_ratio`` (rms relative residuals of the GA optimum
+  over the repeat scatter, frequency and damping) and emcee's RandomState (``rs_*``);
+* ``constraints.txt`` -- convergence (and why the chain stopped), the fit of the optimum
+  against the repeat scatter, the modes, then one sentence per parameter and correlation;
 * ``predictive.csv`` -- q_in, f_q05, f_q50, f_q95, zeta_q05, zeta_q50, zeta_q95.
 
 The checkpoint (the same arrays, rewritten after every chunk) lives outside the declared
@@ -32,11 +36,12 @@ from ..calibrate.settings import CalibrateSettings
 from ..calibrate.space import PARAMS
 from ..io import write_bytes_atomic, write_csv_atomic
 from .likelihood import LogPosterior
+from .modes import find_modes, mode_labels, modes_text
 from .sampler import ChainResult, random_state_arrays, random_state_tuple, run_chain
 from .settings import PosteriorSettings
 from .summary import NAMES, burn_in, constraints_text, predictive_band, summarize
 
-__all__ = ["OUTPUTS", "start_ball", "run_posterior"]
+__all__ = ["OUTPUTS", "start_ball", "run_posterior", "goodness_of_fit"]
 
 OUTPUTS = ("summary.csv", "chain.npz", "constraints.txt", "predictive.csv")
 
@@ -54,6 +59,43 @@ def start_ball(lp: LogPosterior, theta: np.ndarray, ps: PosteriorSettings) -> np
     x0 = x + ps.ball * width * rng.standard_normal((ps.n_walkers, lp.ndim))
     x0 = np.clip(x0, lp.lower + 1e-9 * width, lp.upper - 1e-9 * width)
     return lp.to_y(x0)
+
+
+def goodness_of_fit(lp: LogPosterior, theta: np.ndarray, p_reject: float = 1e-3) -> tuple[list[float], str]:
+    """How far the GA optimum misses the data, against the repeat scatter (the noise floors).
+
+    Parameters
+    ----------
+    lp : LogPosterior
+        Data and noise floors (``lp.data.rel_noise``: relative scatter of f and zeta).
+    theta : ndarray, shape (6,)
+        Fs (lbf), KT (lbf/in), chi, beta, k (lbf/in), zeta_v.
+    p_reject : float
+        Chi-square probability below which the sentence says the data reject the model.
+
+    Returns
+    -------
+    ratios : list of float
+        rms relative residual of f and of zeta divided by its repeat scatter.
+    sentence : str
+    """
+    from scipy.stats import chi2
+
+    x = lp.space.to_unit(theta) * (lp.space.x_hi - lp.space.x_lo) + lp.space.x_lo
+    r_f, r_z = lp.residuals(x[None])
+    s_f, s_z = lp.data.rel_noise
+    rms = [float(np.sqrt(np.mean(r_f**2))), float(np.sqrt(np.mean(r_z**2)))]
+    ratios = [rms[0] / s_f, rms[1] / s_z]
+    n = r_f.size
+    stat = float(np.sum((r_f / s_f) ** 2) + np.sum((r_z / s_z) ** 2))
+    dof = max(2 * n - len(theta), 1)
+    p = float(chi2.sf(stat, dof))
+    verdict = ("the data reject the model at the precision of the repeats (model error, not noise, sets the "
+               "noise scales, which widen the intervals)" if p < p_reject else
+               "consistent with the repeat scatter")
+    return ratios, (f"Fit of the GA optimum: rms relative residuals {rms[0]:.2g} (frequency) and {rms[1]:.2g} "
+                    f"(damping) = {ratios[0]:.1f} and {ratios[1]:.1f} x the repeat scatter; chi-square {stat:.0f} "
+                    f"for {dof} degrees of freedom (p = {p:.1g}): {verdict}.")
 
 
 def _npz(arrays: dict) -> bytes:
@@ -143,32 +185,50 @@ def run_posterior(modal_csv: str | os.PathLike[str], scatter_csv: str | os.PathL
                      + (f"; checkpoint {ckpt}" if ckpt is not None else ""))
 
     res = run_chain(lp, y0, seed=ps.seed, max_steps=ps.max_steps, chunk=ps.chunk, tau_factor=ps.tau_factor,
-                    tau_rtol=ps.tau_rtol, observe=lambda c: lp.to_x(c)[..., [0, 1, 3, 4]], resume=resume,
+                    tau_rtol=ps.tau_rtol, stop_projected=ps.stop_projected, min_chunks=ps.min_chunks,
+                    observe=lambda c: lp.to_x(c)[..., [0, 1, 3, 4]], resume=resume,
                     on_chunk=None if ckpt is None and progress is None else save)
     chain_x = lp.to_x(res.chain)
     burn = burn_in(res.tau, res.steps, ps.burn_tau)
     summary = summarize(chain_x, lp.lower, lp.upper, burn=burn, ratio=ps.constrained_ratio)
     kept = chain_x[burn:].reshape(-1, lp.ndim)
+    labels = mode_labels(kept, seed=ps.seed)  # in x: log10 of the scale parameters
+    modes = find_modes(lp.physical(kept), NAMES, labels=labels)
     step = max(1, len(kept) // ps.predictive_draws)
-    samples = lp.physical(kept[::step][: ps.predictive_draws])
+    pick = np.arange(len(kept))[::step][: ps.predictive_draws]
+    samples = lp.physical(kept[pick])
     q = np.geomspace(data.q.min() / cal.curve_widen, data.q.max() * cal.curve_widen, cal.curve_points)
     band = predictive_band(samples[:, :6], q, m=cal.m, model=cal.model, viscous=cal.viscous)
     tmax = float(np.max(res.tau))
+    if res.converged:
+        status = "converged by the 50-tau rule"
+    elif res.stop_reason == "projected":
+        status = (f"NOT converged: stopped early, 50 tau would need about {res.projected_steps:.0f} steps "
+                  f"(extrapolated from the running tau) > {ps.stop_projected:g} x max_steps {ps.max_steps}"
+                  if np.isfinite(res.projected_steps) else
+                  f"NOT converged: stopped early, the chain length in units of tau stopped growing (the walkers "
+                  f"do not mix), so 50 tau is out of reach of max_steps {ps.max_steps}")
+        status += "; treat the intervals as provisional"
+    else:
+        status = f"NOT converged: stopped at max_steps {ps.max_steps}; treat the intervals as provisional"
     head = (f"emcee: {ps.n_walkers} walkers, {res.steps} steps = {res.steps / tmax:.1f} x the largest "
-            f"autocorrelation time ({tmax:.0f} steps); " + ("converged by the 50-tau rule" if res.converged else
-            f"NOT converged: stopped at max_steps {ps.max_steps}; treat the intervals as provisional") +
-            f"; burn-in {burn} steps; mean acceptance {np.mean(res.acceptance):.2f}.")
-    text = head + "\n" + constraints_text(summary, chain_x, burn=burn, q_max=float(data.q.max()),
-                                          ratio=ps.constrained_ratio)
+            f"autocorrelation time ({tmax:.0f} steps); {status}; burn-in {burn} steps; mean acceptance "
+            f"{np.mean(res.acceptance):.2f}.")
+    fit_ratio, fit_line = goodness_of_fit(lp, theta)
+    text = (head + "\n" + fit_line + "\n" + modes_text(modes, PARAMS, converged=res.converged) + "\n"
+            + constraints_text(summary, chain_x, burn=burn, q_max=float(data.q.max()), ratio=ps.constrained_ratio))
     out = Path(out_dir)
     write_csv_atomic(summary, out / "summary.csv")
     final = arrays(res.chain, res.log_prob, res.random_state, res.tau_history, res.acceptance * res.steps)
-    final.update(samples=samples, sample_names=np.array(NAMES), burn=burn, converged=res.converged)
+    final.update(samples=samples, sample_names=np.array(NAMES), burn=burn, converged=res.converged,
+                 stop_reason=np.array(res.stop_reason), projected_steps=res.projected_steps,
+                 sample_mode=labels[pick], fit_ratio=np.asarray(fit_ratio))
     write_bytes_atomic(_npz(final), out / "chain.npz")
     (out / "constraints.txt").parent.mkdir(parents=True, exist_ok=True)
     write_bytes_atomic(text.encode(), out / "constraints.txt")
     write_csv_atomic(band, out / "predictive.csv")
     notes.append(head)
+    notes.append(fit_line)
     notes.append(f"noise floors (relative): frequency {data.rel_noise[0]:.3g}, damping {data.rel_noise[1]:.3g}")
     return res, notes
 
