@@ -1,8 +1,6 @@
 # Stage validate: the calibrated model driven by each run's measured base record, through the
 # same envelopes and modal code (jointcal.validate); Fig. 3.11.
 # Include after posterior.smk (uses ASSEMBLY_RE and POSTERIOR).
-import jointcal
-
 VALIDATION = RESULTS / "validation"
 
 
@@ -23,13 +21,15 @@ rule validate_assembly:
         summary=VALIDATION / "{assembly}" / "summary.json",
         envelopes=directory(VALIDATION / "{assembly}" / "envelopes"),
     params:
-        version=jointcal.__version__,
+        code=source_hash("validate.py"),
         validate=config.get("validate", {}),
         envelopes=config["envelopes"],
         modal=config["modal"],
     wildcard_constraints:
         assembly=ASSEMBLY_RE,
     threads: 2
+    benchmark:
+        RESULTS / "benchmarks" / "validate_{assembly}.tsv"
     log:
         RESULTS / "logs" / "validate" / "{assembly}.log",
     script:
@@ -45,9 +45,11 @@ rule validate_figures:
         figure=report(RESULTS / "figures" / "fig3_11_validation.png", caption="../report/fig3_11_validation.rst",
                       category="Validation"),
     params:
-        version=jointcal.__version__,
+        code=source_hash("validate_figures.py"),
         assemblies=ASSEMBLIES,
     threads: 1
+    benchmark:
+        RESULTS / "benchmarks" / "validate_figures.tsv"
     log:
         RESULTS / "logs" / "validate_figures.log",
     script:
