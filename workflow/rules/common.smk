@@ -34,3 +34,8 @@ ASSEMBLIES = list(dict.fromkeys(r["assembly"] for r in _manifest_rows() if r.get
 def run_record(wildcards):
     """The raw record of one run."""
     return RUN_FILES[wildcards.run_id]
+
+
+def assembly_records(wildcards):
+    """The raw records of one assembly's runs."""
+    return [str(RAW_DATA / r["file"]) for r in _manifest_rows() if r.get("assembly") == wildcards.assembly]
