@@ -159,8 +159,8 @@ def test_workflow_validate_stage_reruns_only_itself_on_a_config_edit(tmp_path, s
     shutil.copy(REPO / "Snakefile", work)
     for folder in ("workflow", "profiles"):
         shutil.copytree(REPO / folder, work / folder, ignore=shutil.ignore_patterns("__pycache__"))
-    small = {"calibrate": {"population": 40, "offspring": 40, "generations": 6, "n_polish": 1},
-             "posterior": {"max_steps": 400, "chunk": 200}, "validate": {"n_draws": 2}}
+    small = {"calibrate": {"population": 20, "offspring": 20, "generations": 3, "n_polish": 0},
+             "posterior": {"max_steps": 100, "chunk": 100, "predictive_draws": 10}, "validate": {"n_draws": 2}}
     (work / "small.yaml").write_text(yaml.safe_dump(small))
     out = tmp_path / "results"
 
