@@ -6,6 +6,7 @@ Oracles: an analytic FRF for a linear model; the truth that generated a syntheti
 from __future__ import annotations
 
 import json
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -125,12 +126,18 @@ def _campaign(tmp: Path, effect: dict) -> tuple[list, list, dict, dict]:
 
 @pytest.mark.slow
 def test_E_of_the_calibrated_model_is_at_the_noise_floor_and_grows_with_a_hidden_effect(tmp_path):
+    """Issue 8: E(calibrated) <= 1.5 E(true model) without an effect; >= 3x with sensor_gain 1.15.
+
+    One assembly, 1 g x2 repeats up/down, 5 g and 10 g, band 1600-2600 Hz (CI time).
+    Measured when written: E true 0.55, calibrated 0.68, sensor_gain 16.5.
+    """
     rows, records, best, truth = _campaign(tmp_path / "none", {"name": "none"})
     a = truth["assemblies"]["first"]
-    e_true = validate_runs(lambda r: run_model(a, r["sequence"]), records, rows).error["E"]
-    e_cal = validate_runs(lambda r: model_from_best(best), records, rows).error["E"]
-    rows, records, best_g, _ = _campaign(tmp_path / "gain", {"name": "sensor_gain", "params": {"gain": 1.15}})
-    v_gain = validate_runs(lambda r: model_from_best(best_g), records, rows)
+    with ProcessPoolExecutor(max_workers=2) as ex:
+        e_true = validate_runs([run_model(a, r["sequence"]) for r in rows], records, rows, executor=ex).error["E"]
+        e_cal = validate_runs(lambda r: model_from_best(best), records, rows, executor=ex).error["E"]
+        rows, records, best_g, _ = _campaign(tmp_path / "gain", {"name": "sensor_gain", "params": {"gain": 1.15}})
+        v_gain = validate_runs(lambda r: model_from_best(best_g), records, rows, executor=ex)
     print(f"\nE: true model {e_true:.2f}, calibrated {e_cal:.2f}, calibrated on a sensor_gain 1.15 campaign "
           f"{v_gain.error['E']:.2f}\n{v_gain.words}")
     assert e_cal <= 1.5 * e_true
@@ -152,14 +159,14 @@ def test_workflow_validate_stage_reruns_only_itself_on_a_config_edit(tmp_path, s
     shutil.copy(REPO / "Snakefile", work)
     for folder in ("workflow", "profiles"):
         shutil.copytree(REPO / folder, work / folder, ignore=shutil.ignore_patterns("__pycache__"))
-    small = {"calibrate": {"population": 40, "offspring": 40, "generations": 6, "n_polish": 1},
-             "posterior": {"max_steps": 400, "chunk": 200}, "validate": {"n_draws": 2}}
+    small = {"calibrate": {"population": 20, "offspring": 20, "generations": 3, "n_polish": 0},
+             "posterior": {"max_steps": 100, "chunk": 100, "predictive_draws": 10}, "validate": {"n_draws": 2}}
     (work / "small.yaml").write_text(yaml.safe_dump(small))
     out = tmp_path / "results"
 
     def smk(*args):
-        return subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", "--configfile", "small.yaml",
-                               "--config", f"raw_data={small_campaign}", f"results={out}", *args], cwd=work,
+        return subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", *args, "--configfile", "small.yaml",
+                               "--config", f"raw_data={small_campaign}", f"results={out}"], cwd=work,
                               capture_output=True, text=True, timeout=600)
 
     res = smk("validate")

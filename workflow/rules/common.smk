@@ -60,6 +60,11 @@ def run_record(wildcards):
     return RUN_FILES[wildcards.run_id]
 
 
+def assembly_records(wildcards):
+    """The raw records of one assembly's runs."""
+    return [str(RAW_DATA / r["file"]) for r in _manifest_rows() if r.get("assembly") == wildcards.assembly]
+
+
 def remove_stale_outputs():
     """After a failed run, remove the outputs of every job the run had scheduled and did not finish.
 

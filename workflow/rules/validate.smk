@@ -4,11 +4,6 @@
 VALIDATION = RESULTS / "validation"
 
 
-def assembly_records(wildcards):
-    """The raw records of one assembly's runs."""
-    return [str(RAW_DATA / r["file"]) for r in _manifest_rows() if r.get("assembly") == wildcards.assembly]
-
-
 rule validate_assembly:
     input:
         runs=RESULTS / "ingest" / "runs.csv",

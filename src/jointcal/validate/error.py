@@ -174,8 +174,15 @@ def describe_misfit(metrics: pd.DataFrame, err: Mapping, *, level_unit: str = "g
                  + "; per level " + ", ".join(f"{k:g} {level_unit}: {v * 100:+.2f}%" for k, v in lv.items()) + ").")
     zm = float(np.nanmedian(m["zeta_rel_err"]))
     words.append(f"Its damping is {_pct(zm)} {'above' if zm > 0 else 'below'} the measured (median).")
-    lo = float(np.nanmedian(m["low_freq_ratio"]))
-    if np.isfinite(lo):
+    fl = [float(m[c].dropna().median()) if m[c].notna().any() else np.nan
+          for c in ("flank_below_ratio", "flank_above_ratio")]
+    if np.all(np.isfinite(fl)):
+        words.append(f"On the resonance's flanks (1 to 3 half-power half-widths away) the measured response is "
+                     f"{_pct(1 / fl[0] - 1)} {'above' if fl[0] < 1 else 'below'} the model's below resonance and "
+                     f"{_pct(1 / fl[1] - 1)} {'above' if fl[1] < 1 else 'below'} it above resonance (medians).")
+    lo_ok = m["low_freq_ratio"].dropna()
+    if len(lo_ok):
+        lo = float(lo_ok.median())
         words.append(f"Far below resonance (f < 0.7 f_res) the measured response is {_pct(1 / lo - 1)} "
                      f"{'above' if lo < 1 else 'below'} the model's.")
     return " ".join(words)

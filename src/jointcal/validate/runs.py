@@ -132,6 +132,8 @@ def compare_run(env_m: pd.DataFrame, props_m: Mapping, env_s: pd.DataFrame, prop
     b = frames[frames["in_band"]]
     below = frames[(frames["f_hz"] < 0.7 * f_res) & inside]
     zm, zs = float(props_m.get(zeta_key, np.nan)), float(props_s.get(zeta_key, np.nan))
+    x = (b["f_hz"] / f_res - 1.0) / zm  # distance from resonance in half-power half-widths
+    flank_lo, flank_hi = b[(x >= -3) & (x <= -1)], b[(x >= 1) & (x <= 3)]
     peak_m = float(b["resp_meas_g"].max()) if len(b) else np.nan
     peak_s = float(b["resp_sim_g"].max()) if len(b) else np.nan
     metrics = {**head, "n_frames": int(len(b)), "band_lo_hz": lo, "band_hi_hz": hi,
@@ -143,6 +145,8 @@ def compare_run(env_m: pd.DataFrame, props_m: Mapping, env_s: pd.DataFrame, prop
                "f_res_meas_hz": f_res, "f_res_sim_hz": float(props_s["f_res_hz"]),
                "f_res_rel_err": float(props_s["f_res_hz"]) / f_res - 1.0,
                "zeta_meas": zm, "zeta_sim": zs, "zeta_rel_err": zs / zm - 1.0,
+               "flank_below_ratio": float(10 ** (flank_lo["d_mag_db"].median() / 20)) if len(flank_lo) else np.nan,
+               "flank_above_ratio": float(10 ** (flank_hi["d_mag_db"].median() / 20)) if len(flank_hi) else np.nan,
                "low_freq_ratio": float(10 ** (below["d_mag_db"].median() / 20)) if len(below) else np.nan,
                "flags_meas": props_m.get("flags", ""), "flags_sim": props_s.get("flags", ""), "note": ""}
     return frames, metrics
