@@ -13,7 +13,7 @@ import pandas as pd
 
 from jointcal.calibrate import LOG_SCALED, PARAMS, CalibrateSettings
 from jointcal.io import write_bytes_atomic
-from jointcal.posterior import PosteriorSettings, find_modes, modes_text
+from jointcal.posterior import PosteriorSettings
 from jointcal.report.calibration import corner_figure
 from jointcal.report.summary import chain_status, ga_best_point, rst_escape
 
@@ -43,8 +43,6 @@ def main(smk) -> None:
                                      bounds=bounds, modes=modes, stamp=(line.split(";")[0], ok)),
                        smk.output.corner)
     text = [f"**This run: {rst_escape(line)}.**"]
-    if modes is not None:
-        text.append(rst_escape(modes_text(find_modes(samples, names, labels=modes), PARAMS, converged=ok)))
     text += [rst_escape(s) for s in Path(smk.input.constraints).read_text().splitlines()[1:] if s.strip()]
     write_bytes_atomic(("\n\n".join(text) + "\n").encode(), smk.output.caption)
     Path(smk.log[0]).write_text(f"jointcal: corner plot of {len(samples)} posterior draws; {line}\n")

@@ -10,7 +10,7 @@ import pandas as pd
 from jointcal.calibrate import CalibrateSettings
 from jointcal.io import write_bytes_atomic
 from jointcal.posterior import NAMES, PosteriorSettings, find_modes
-from jointcal.report.summary import chain_status, ga_best_point, summary_html, table_3_2_html
+from jointcal.report.summary import bound_hits, chain_status, ga_best_point, landing_html, summary_html, table_3_2_html
 
 
 def main(smk) -> None:
@@ -28,10 +28,22 @@ def main(smk) -> None:
     ga = {a: ga_best_point(pd.read_csv(p)) for a, p in zip(names, smk.input.history)}
     table = pd.read_csv(smk.input.table)
     table_html = table_3_2_html(table, ga, modes, {k: list(v) for k, v in cal.bounds.items()})
-    page = summary_html(campaign=str(smk.params.campaign), runs=pd.read_csv(smk.input.runs, dtype={"flags": str}),
-                        modal=pd.read_csv(smk.input.modal, dtype={"flags": str}), status=status,
+    modal = pd.read_csv(smk.input.modal, dtype={"flags": str})
+    runs = pd.read_csv(smk.input.runs[0], dtype={"flags": str}) if len(smk.input.runs) else modal
+    page = summary_html(campaign=str(smk.params.campaign), runs=runs, modal=modal, status=status,
                         constraints=constraints, table_html=table_html)
     write_bytes_atomic(page.encode(), smk.output.summary)
+    notes = {}
+    bounds = {k: list(v) for k, v in cal.bounds.items()}
+    for a, g in table.groupby("assembly", sort=False):
+        n = []
+        if a in modes and modes[a]["mode"].max() > 0:
+            n.append(f"MULTIMODAL ({int(modes[a]['mode'].max()) + 1} modes)")
+        hits = bound_hits(dict(zip(g["param"], g["ga_optimum"])), bounds)
+        if hits:
+            n.append("optimum at a bound: " + ", ".join(f"{p} ({side})" for p, side in hits.items()))
+        notes[a] = n
+    write_bytes_atomic(landing_html(runs=runs, modal=modal, status=status, notes=notes).encode(), smk.output.landing)
     write_bytes_atomic(table_html.encode(), smk.output.table)
     Path(smk.log[0]).write_text("".join(f"jointcal: {a}: {line}\n" for a, (_, line) in status.items()))
 

@@ -75,7 +75,7 @@ def amplitude_figure(measured: Mapping[str, pd.DataFrame], curves: Mapping[str, 
             ax.set_ylabel(label)
             ax.set_title(f"{name}: {label.split(' ')[0]}")
             ax.grid(True, which="both", alpha=0.3)
-        row[0].legend(fontsize=7, loc="lower left")
+        row[0].legend(fontsize=8, loc="lower left")
     fig.tight_layout()
     return _png(fig)
 
@@ -168,19 +168,19 @@ def exploration_figure(history: pd.DataFrame, *, title: str = "", max_points: in
                 ax.set_ylabel(_axis_label(ci), fontsize=9)
             elif j != i:
                 ax.set_yticklabels([])
-    if sc is not None:
-        cax = fig.add_axes((0.90, 0.55, 0.018, 0.35))
-        cb = fig.colorbar(sc, cax=cax)
-        cb.set_label("log10 objective (eq. 3.9)", fontsize=9)
-        cb.ax.tick_params(labelsize=8)
     if points:
         handles, labels = axes[1, 0].get_legend_handles_labels()
         text = [f"{lab}: objective {fmt(v['objective'])}" if "objective" in v else lab
                 for lab, (v, _) in points.items()]
         fig.legend(handles, text, loc="upper right", bbox_to_anchor=(0.99, 0.52), fontsize=9, frameon=False)
-    fig.suptitle(f"GA exploration {title} (colour: log10 objective, dark = low; dashed grey: search bounds)".strip(),
+    fig.suptitle(f"GA exploration {title} (colour: log10 objective, dark = low; axes span the search bounds)".strip(),
                  fontsize=11)
     fig.tight_layout(rect=(0, 0, 0.88, 0.97))
+    if sc is not None:  # after tight_layout, which does not handle a free-standing axes
+        cax = fig.add_axes((0.90, 0.55, 0.018, 0.35))
+        cb = fig.colorbar(sc, cax=cax)
+        cb.set_label("log10 objective (eq. 3.9)", fontsize=9)
+        cb.ax.tick_params(labelsize=8)
     return _png(fig)
 
 
@@ -195,7 +195,7 @@ def convergence_figure(logbooks: Mapping[str, pd.DataFrame]) -> bytes:
     ax.set_xlabel("generation")
     ax.set_ylabel("objective (eq. 3.9)")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=8)
     fig.tight_layout()
     return _png(fig)
 

@@ -20,7 +20,7 @@ import pandas as pd
 
 from ..calibrate.space import LOG_SCALED, PARAMS, UNITS
 
-__all__ = ["rst_escape", "ga_best_point", "bound_hits", "chain_status", "table_3_2_html", "summary_html", "fmt"]
+__all__ = ["rst_escape", "ga_best_point", "bound_hits", "chain_status", "table_3_2_html", "summary_html", "landing_html", "fmt"]
 
 
 def rst_escape(text: str) -> str:
@@ -69,6 +69,18 @@ def bound_hits(theta: Mapping[str, float], bounds: Mapping[str, Sequence[float]]
     return hits
 
 
+def _touches(p: str, q05: float, q95: float, bounds: Mapping[str, Sequence[float]], tol: float = 0.02) -> str | None:
+    """"lower"/"upper" when a 90% interval reaches within `tol` of the prior width of a bound, else None."""
+    lo, hi = (float(b) for b in bounds[p])
+    f = np.log10 if LOG_SCALED.get(p, True) else (lambda v: v)
+    w = f(hi) - f(lo)
+    if np.isfinite(q05) and f(q05) - f(lo) <= tol * w:
+        return "lower"
+    if np.isfinite(q95) and f(hi) - f(q95) <= tol * w:
+        return "upper"
+    return None
+
+
 def chain_status(z: Mapping, *, tau_factor: float = 50.0) -> tuple[bool, str]:
     """Convergence of one posterior from its ``chain.npz`` arrays.
 
@@ -94,9 +106,9 @@ def chain_status(z: Mapping, *, tau_factor: float = 50.0) -> tuple[bool, str]:
 
 
 _CSS = """<style>
-.prose.max-w-lg{max-width:72rem}
-.jc-summary{font-size:13px;line-height:1.35}
-.jc-summary table{border-collapse:collapse;margin:0.4em 0 1em 0;font-size:12px}
+body{font-family:sans-serif;margin:1em}
+.jc-summary{font-size:14px;line-height:1.4}
+.jc-summary table{border-collapse:collapse;margin:0.4em 0 1em 0;font-size:13px}
 .jc-summary th,.jc-summary td{border:1px solid #bbb;padding:2px 6px;text-align:right;white-space:nowrap}
 .jc-summary th{background:#eee}
 .jc-summary td.lab{text-align:left}
@@ -145,7 +157,9 @@ def table_3_2_html(table: pd.DataFrame, ga_points: Mapping[str, Mapping[str, flo
             r = g.loc[p]
             free = r["constrained"] is False or r["constrained"] == False  # noqa: E712
             text = f"{fmt(r['posterior_median'])} [{fmt(r['posterior_q05'])}, {fmt(r['posterior_q95'])}]"
-            cells.append(_cell(text + ("*" if free else ""), "free" if free else ""))
+            edge = _touches(p, r["posterior_q05"], r["posterior_q95"], bounds) if bounds else None
+            note = f" (touches {edge} bound)" if edge else ""
+            cells.append(_cell(text + ("*" if free else "") + note, "bound" if edge else ("free" if free else "")))
         label = "posterior median [q05, q95]" + (" <span class='bad'>(between modes)</span>" if n_modes > 1 else "")
         rows.append(f"<tr><td class='lab'>{html.escape(name)}</td><td class='lab'>{label}</td>{''.join(cells)}</tr>")
         for k in range(n_modes if n_modes > 1 else 0):
@@ -184,7 +198,8 @@ def summary_html(*, campaign: str, runs: pd.DataFrame, modal: pd.DataFrame, stat
     fits : mapping assembly -> str, optional
         Extra sentences per assembly.
     """
-    out = [_CSS, '<div class="jc-summary">']
+    out = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>jointcal summary</title>", _CSS,
+           "</head><body>", '<div class="jc-summary">', "<h2>jointcal: summary of this run</h2>"]
     n_asm = runs["assembly"].nunique() if "assembly" in runs else 0
     level = "level_g" if "level_g" in runs.columns else ("level_lbf" if "level_lbf" in runs.columns else None)
     levels = "" if level is None else ", levels " + ", ".join(f"{v:g}" for v in sorted(runs[level].dropna().unique()))
@@ -192,16 +207,8 @@ def summary_html(*, campaign: str, runs: pd.DataFrame, modal: pd.DataFrame, stat
                f"{html.escape(levels)}{' g' if level == 'level_g' else (' lbf' if level else '')}.</p>")
     flag_rows = []
     for label, t in (("ingest (runs.csv)", runs), ("modal (modal_properties.csv)", modal)):
-        f = t["flags"].fillna("").astype(str) if "flags" in t else pd.Series([], dtype=str)
-        flagged = f[f.str.strip() != ""]
-        kinds: dict[str, int] = {}
-        for v in flagged:
-            for k in v.replace(",", ";").split(";"):
-                k = k.strip().split(":")[0].split("(")[0].strip()
-                if k:
-                    kinds[k] = kinds.get(k, 0) + 1
-        detail = "; ".join(f"{k}: {n}" for k, n in sorted(kinds.items()))
-        flag_rows.append(f"<li>{label}: <b>{len(flagged)}</b> of {len(t)} runs flagged"
+        n, detail = _flag_counts(t)
+        flag_rows.append(f"<li>{label}: <b>{n}</b> of {len(t)} runs flagged"
                          + (f" ({html.escape(detail)})" if detail else "") + "</li>")
     out.append("<p><b>Run flags</b></p><ul>" + "".join(flag_rows) + "</ul>")
     out.append("<p><b>Posterior convergence</b></p><ul>")
@@ -217,5 +224,38 @@ def summary_html(*, campaign: str, runs: pd.DataFrame, modal: pd.DataFrame, stat
         if fits and name in fits:
             out.append(f"<li>{html.escape(fits[name])}</li>")
         out.append("</ul>")
+    out.append("</div></body></html>")
+    return "\n".join(out) + "\n"
+
+
+def _flag_counts(t: pd.DataFrame) -> tuple[int, str]:
+    f = t["flags"].fillna("").astype(str) if "flags" in t else pd.Series([], dtype=str)
+    flagged = f[f.str.strip() != ""]
+    kinds: dict[str, int] = {}
+    for v in flagged:
+        for k in v.replace(",", ";").split(";"):
+            k = k.strip().split(":")[0].split("(")[0].strip()
+            if k:
+                kinds[k] = kinds.get(k, 0) + 1
+    return len(flagged), "; ".join(f"{k}: {n}" for k, n in sorted(kinds.items()))
+
+
+def landing_html(*, runs: pd.DataFrame, modal: pd.DataFrame, status: Mapping[str, tuple[bool, str]],
+                 notes: Mapping[str, Sequence[str]] | None = None) -> str:
+    """A few lines for the report's landing page: run flags counted and each posterior's convergence.
+
+    Short on purpose: Snakemake's landing page centres its content and clips a long one.
+    ``notes`` adds short warnings per assembly (e.g. multimodal, a parameter at a bound).
+    """
+    out = ['<div style="font-size:13px;line-height:1.35">']
+    for label, t in (("ingest", runs), ("modal", modal)):
+        n, detail = _flag_counts(t)
+        out.append(f"<div>Run flags, {label}: <b>{n}</b> of {len(t)} runs"
+                   + (f" ({html.escape(detail)})" if detail else "") + "</div>")
+    for name, (ok, line) in status.items():
+        colour = "#006400" if ok else "#b00000"
+        extra = "".join(f"; {html.escape(n)}" for n in (notes or {}).get(name, ()))
+        out.append(f"<div>Posterior <b>{html.escape(name)}</b>: <span style='color:{colour};font-weight:bold'>"
+                   f"{html.escape(line)}</span>{extra}</div>")
     out.append("</div>")
     return "\n".join(out) + "\n"
