@@ -22,6 +22,9 @@ min_version("8.0")
 configfile: "workflow/config/config.yaml"
 
 
+report: "workflow/report/workflow.rst"
+
+
 include: "workflow/rules/common.smk"  # checks and validates the config first
 include: "workflow/rules/ingest.smk"
 include: "workflow/rules/envelopes.smk"

@@ -15,8 +15,8 @@ from _modal_tables import TABLE_3_2, modal_tables, write_tables
 from jointcal.calibrate import PARAMS, CalibrateSettings, CalibrationInputError, run_calibration, select_modal
 from jointcal.models import harmonic_balance
 from jointcal.posterior import (
-    LogPosterior, PosteriorSettings, constraints_text, log_det_dy_dx, run_chain, run_posterior, summarize,
-    x_to_y, y_to_x,
+    LogPosterior, PosteriorSettings, constraints_text, log_det_dy_dx, projected_steps, run_chain, run_posterior,
+    summarize, x_to_y, y_to_x,
 )
 
 CAL = CalibrateSettings()
@@ -82,6 +82,33 @@ def test_chain_stops_after_50_tau_and_resumes_exactly():
     np.testing.assert_array_equal(resumed.tau_history, full.tau_history)
     other = run_chain(_gauss, x0, seed=4, max_steps=500, chunk=500)
     assert not np.array_equal(other.chain, full.chain[:500])
+
+
+def test_chain_whose_tau_grows_stops_early_and_says_why(monkeypatch):
+    import jointcal.posterior.sampler as sampler
+
+    x0 = 0.01 * np.random.default_rng(0).standard_normal((16, 2))
+    on = run_chain(_gauss, x0, seed=3, max_steps=20000, chunk=500, stop_projected=1.5, min_chunks=5)
+    off = run_chain(_gauss, x0, seed=3, max_steps=20000, chunk=500)
+    assert on.converged and on.stop_reason == "converged" and on.steps == off.steps  # a mixing chain runs on
+    # walkers that do not mix: the running tau grows in proportion to the chain (8 steps per 64, as the example
+    # campaign's first chunks), so the chain length in units of tau stays flat and 50 tau is never reached
+    monkeypatch.setattr(sampler, "_tau", lambda chain, observe: np.full(chain.shape[-1], len(chain) / 8.0))
+    saved = []
+    res = run_chain(_gauss, x0, seed=3, max_steps=20000, chunk=500, stop_projected=1.5, min_chunks=5,
+                    on_chunk=lambda s: saved.append(pickle.dumps(s)))
+    assert not res.converged and res.stop_reason == "projected" and res.projected_steps > 1e9  # flat: no end
+    assert res.steps == 3000  # checks 5 and 6 (min_chunks, then once more), not the cap of 40 checks
+    again = run_chain(_gauss, x0, seed=3, max_steps=20000, chunk=500, stop_projected=1.5, min_chunks=5,
+                      resume=pickle.loads(saved[-2]))  # an interrupted run stops where the whole one did
+    np.testing.assert_array_equal(again.chain, res.chain)
+    capped = run_chain(_gauss, x0, seed=3, max_steps=4000, chunk=500)  # early stop off: runs to the cap
+    assert capped.steps == 4000 and capped.stop_reason == "max_steps"
+    # projections: tau settled at 100 steps -> 50 tau = 5000 steps; r = N/tau growing slowly -> far beyond
+    assert projected_steps([[1000, 100.0], [2000, 100.0], [3000, 100.0]]) == pytest.approx(5000)
+    r1, r3 = 4000 / 495.0, 6000 / 643.0  # equally spaced checks: the least-squares slope is (r3 - r1) / 2000
+    assert projected_steps([[4000, 495.0], [5000, 576.0], [6000, 643.0]]) == pytest.approx(
+        6000 + (50 - r3) / ((r3 - r1) / 2000), rel=1e-9)
 
 
 def test_summary_flags_unconstrained_parameters_and_correlations():

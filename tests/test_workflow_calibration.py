@@ -90,7 +90,14 @@ def test_calibrate_then_posterior_then_nothing_to_do_until_the_config_changes(wo
     assert res.returncode == 0 and "calibrate_assembly" in res.stdout + res.stderr
     res = _snakemake(workdir, "--report", str(workdir / "report.html"))
     assert res.returncode == 0, res.stderr
+    html = (workdir / "report.html").read_text()
     assert (workdir / "report.html").stat().st_size > 100_000
+    # the report opens on a summary (workflow.rst with the convergence lines) and renders Table 3.2 in HTML
+    assert "Open" in html and "0. Summary" in html and "NOT converged" in html
+    summary = (out / "report" / "summary.html").read_text()
+    assert "NOT converged" in summary and "<table>" in summary and "polished optimum" in summary
+    assert summary.count("GA best (before polish)") == 2 and "first" in (out / "report" / "landing.html").read_text()
+    assert "This run: NOT converged" in (out / "report" / "corner_first.rst").read_text()
 
 
 def test_bad_input_is_one_sentence_naming_the_file(workdir):

@@ -34,15 +34,18 @@ rule calibration_figures:
     input:
         history=CALIBRATION / "{assembly}" / "ga_history.csv",
         logbook=CALIBRATION / "{assembly}" / "ga_logbook.csv",
+        best=CALIBRATION / "{assembly}" / "ga_best.json",
     output:
         exploration=report(RESULTS / "figures" / "ga_exploration_{assembly}.png",
-                           caption="../report/ga_exploration.rst", category="Calibration",
+                           caption="../report/ga_exploration.rst", category="2. Calibration",
                            subcategory="{assembly}"),
         convergence=report(RESULTS / "figures" / "ga_convergence_{assembly}.png",
-                           caption="../report/ga_convergence.rst", category="Calibration",
+                           caption="../report/ga_convergence.rst", category="2. Calibration",
                            subcategory="{assembly}"),
+        caption=RESULTS / "report" / "ga_{assembly}.rst",
     params:
         code=source_hash("calibration_figures.py"),
+        calibrate=config.get("calibrate", {}),
     wildcard_constraints:
         assembly=ASSEMBLY_RE,
     threads: 1

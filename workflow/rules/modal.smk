@@ -29,11 +29,11 @@ rule modal_figures:
         records=list(RUN_FILES.values()),
     output:
         envelopes=report(RESULTS / "figures" / "fig3_5_envelopes.png",
-                         caption="../report/fig3_5_envelopes.rst", category="Modal properties"),
+                         caption="../report/fig3_5_envelopes.rst", category="1. Modal properties"),
         amplitude=report(RESULTS / "figures" / "fig3_6_frequency_damping.png",
-                         caption="../report/fig3_6_frequency_damping.rst", category="Modal properties"),
+                         caption="../report/fig3_6_frequency_damping.rst", category="1. Modal properties"),
         spectrogram=report(RESULTS / "figures" / "spectrogram_ridge.png",
-                           caption="../report/spectrogram_ridge.rst", category="Modal properties"),
+                           caption="../report/spectrogram_ridge.rst", category="1. Modal properties"),
     params:
         code=source_hash("modal_figures.py"),
         envelopes=config["envelopes"],

@@ -34,11 +34,17 @@ rule posterior_assembly:
 rule posterior_corner:
     input:
         chain=POSTERIOR / "{assembly}" / "chain.npz",
+        constraints=POSTERIOR / "{assembly}" / "constraints.txt",
+        best=RESULTS / "calibration" / "{assembly}" / "ga_best.json",
+        history=RESULTS / "calibration" / "{assembly}" / "ga_history.csv",
     output:
         corner=report(RESULTS / "figures" / "corner_{assembly}.png", caption="../report/corner.rst",
-                      category="Posterior", subcategory="{assembly}"),
+                      category="3. Posterior", subcategory="{assembly}"),
+        caption=RESULTS / "report" / "corner_{assembly}.rst",
     params:
         code=source_hash("posterior_corner.py"),
+        calibrate=config.get("calibrate", {}),
+        posterior=config.get("posterior", {}),
     wildcard_constraints:
         assembly=ASSEMBLY_RE,
     threads: 1
@@ -59,9 +65,9 @@ rule posterior_report:
         predictive=expand(POSTERIOR / "{assembly}" / "predictive.csv", assembly=ASSEMBLIES),
     output:
         figure=report(RESULTS / "figures" / "fig3_8_amplitude_fit.png", caption="../report/fig3_8_amplitude_fit.rst",
-                      category="Posterior"),
+                      category="3. Posterior"),
         table=POSTERIOR / "table_3_2.csv",
-        markdown=report(POSTERIOR / "table_3_2.md", caption="../report/table_3_2.rst", category="Posterior"),
+        markdown=POSTERIOR / "table_3_2.md",
         qsma=POSTERIOR / "qsma_vs_harmonic_balance.csv",
     params:
         code=source_hash("posterior_report.py"),
@@ -76,8 +82,35 @@ rule posterior_report:
         "../scripts/posterior_report.py"
 
 
+rule report_summary:
+    input:
+        # the ingest table when the workflow has that stage (a Snakefile of calibrate + posterior only has not)
+        runs=lambda wc: [str(RESULTS / "ingest" / "runs.csv")] if hasattr(rules, "ingest") else [],
+        modal=RESULTS / "modal" / "modal_properties.csv",
+        table=POSTERIOR / "table_3_2.csv",
+        history=expand(RESULTS / "calibration" / "{assembly}" / "ga_history.csv", assembly=ASSEMBLIES),
+        chain=expand(POSTERIOR / "{assembly}" / "chain.npz", assembly=ASSEMBLIES),
+        constraints=expand(POSTERIOR / "{assembly}" / "constraints.txt", assembly=ASSEMBLIES),
+    output:
+        summary=report(RESULTS / "report" / "summary.html", caption="../report/summary.rst",
+                       category="0. Summary"),
+        table=report(POSTERIOR / "table_3_2.html", caption="../report/table_3_2.rst", category="3. Posterior"),
+        landing=RESULTS / "report" / "landing.html",
+    params:
+        calibrate=config.get("calibrate", {}),
+        posterior=config.get("posterior", {}),
+        assemblies=ASSEMBLIES,
+        campaign=str(RAW_DATA),
+    threads: 1
+    log:
+        RESULTS / "logs" / "report_summary.log",
+    script:
+        "../scripts/report_summary.py"
+
+
 rule posterior:
     input:
+        rules.report_summary.output,
         expand(POSTERIOR / "{assembly}" / "summary.csv", assembly=ASSEMBLIES),
         expand(RESULTS / "figures" / "corner_{assembly}.png", assembly=ASSEMBLIES),
         rules.posterior_report.output,

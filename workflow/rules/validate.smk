@@ -38,7 +38,7 @@ rule validate_figures:
         envelopes=expand(VALIDATION / "{assembly}" / "envelopes", assembly=ASSEMBLIES),
     output:
         figure=report(RESULTS / "figures" / "fig3_11_validation.png", caption="../report/fig3_11_validation.rst",
-                      category="Validation"),
+                      category="4. Validation"),
     params:
         code=source_hash("validate_figures.py"),
         assemblies=ASSEMBLIES,

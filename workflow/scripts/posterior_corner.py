@@ -1,25 +1,51 @@
-"""Snakemake script of rule ``posterior_corner``: corner plot of one assembly's posterior draws.
+"""Snakemake script of rule ``posterior_corner``: corner plot of one assembly's posterior draws, stamped with
+its convergence, the GA best, the polished optimum, the prior bounds and its modes; and the run-generated
+part of its caption.
 
 Axes in the sampling space (log10 of the scale parameters and noise scales, chi linear).
 (No ``from __future__``: Snakemake prepends a preamble to scripts.)
 """
+import json
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
-from jointcal.calibrate import LOG_SCALED
+from jointcal.calibrate import LOG_SCALED, PARAMS, CalibrateSettings
 from jointcal.io import write_bytes_atomic
+from jointcal.posterior import PosteriorSettings
 from jointcal.report.calibration import corner_figure
+from jointcal.report.summary import chain_status, ga_best_point, rst_escape
 
 
 def main(smk) -> None:
+    cal = CalibrateSettings.from_config(smk.params.calibrate)
+    post = PosteriorSettings.from_config(smk.params.posterior)
     with np.load(smk.input.chain) as z:
-        samples, names = z["samples"], [str(n) for n in z["sample_names"]]
+        arrays = {k: z[k] for k in z.files}
+    samples, names = arrays["samples"], [str(n) for n in arrays["sample_names"]]
     log = [LOG_SCALED.get(n, True) for n in names]
     x = np.where(log, np.log10(np.abs(samples)), samples)
     labels = [f"log10 {n}" if lg else n for n, lg in zip(names, log)]
-    write_bytes_atomic(corner_figure(x, labels, title=smk.wildcards.assembly), smk.output.corner)
-    Path(smk.log[0]).write_text(f"jointcal: corner plot of {len(samples)} posterior draws\n")
+
+    def coords(point: dict) -> list:
+        return [(np.log10(point[n]) if lg else point[n]) if n in point else np.nan for n, lg in zip(names, log)]
+
+    best = json.loads(Path(smk.input.best).read_text())
+    points = {"GA best": coords(ga_best_point(pd.read_csv(smk.input.history))),
+              "polished optimum": coords({p: best[p] for p in PARAMS})}
+    lo = [cal.bounds[n][0] if n in cal.bounds else np.nan for n in names]
+    hi = [cal.bounds[n][1] if n in cal.bounds else np.nan for n in names]
+    bounds = (coords(dict(zip(names, lo))), coords(dict(zip(names, hi))))
+    ok, line = chain_status(arrays, tau_factor=post.tau_factor)
+    modes = arrays.get("sample_mode")
+    write_bytes_atomic(corner_figure(x, labels, title=f"posterior of {smk.wildcards.assembly}", points=points,
+                                     bounds=bounds, modes=modes, stamp=(line.split(";")[0], ok)),
+                       smk.output.corner)
+    text = [f"**This run: {rst_escape(line)}.**"]
+    text += [rst_escape(s) for s in Path(smk.input.constraints).read_text().splitlines()[1:] if s.strip()]
+    write_bytes_atomic(("\n\n".join(text) + "\n").encode(), smk.output.caption)
+    Path(smk.log[0]).write_text(f"jointcal: corner plot of {len(samples)} posterior draws; {line}\n")
 
 
 main(snakemake)  # noqa: F821 (provided by Snakemake)

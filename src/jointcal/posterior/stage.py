@@ -194,8 +194,10 @@ def run_posterior(modal_csv: str | os.PathLike[str], scatter_csv: str | os.PathL
     kept = chain_x[burn:].reshape(-1, lp.ndim)
     labels = mode_labels(kept, seed=ps.seed)  # in x: log10 of the scale parameters
     modes = find_modes(lp.physical(kept), NAMES, labels=labels)
-    step = max(1, len(kept) // ps.predictive_draws)
-    pick = np.arange(len(kept))[::step][: ps.predictive_draws]
+    # draws spread over steps and walkers alike (an even stride through the flattened chain can alias with the
+    # number of walkers and keep only a few of them)
+    pick = np.sort(np.random.default_rng(ps.seed).choice(len(kept), min(ps.predictive_draws, len(kept)),
+                                                         replace=False))
     samples = lp.physical(kept[pick])
     q = np.geomspace(data.q.min() / cal.curve_widen, data.q.max() * cal.curve_widen, cal.curve_points)
     band = predictive_band(samples[:, :6], q, m=cal.m, model=cal.model, viscous=cal.viscous)

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-__all__ = ["plot_envelopes", "plot_frequency_damping", "plot_spectrogram"]
+__all__ = ["steady_frames", "plot_envelopes", "plot_frequency_damping", "plot_spectrogram"]
 
 
 def _plt():
@@ -28,11 +28,22 @@ def _save(fig, path) -> None:
     tmp.replace(path)
 
 
-def plot_envelopes(table: pd.DataFrame, envs: dict[str, pd.DataFrame], path) -> None:
+def steady_frames(env: pd.DataFrame, ramp_fraction: float = 0.95) -> pd.Series:
+    """Drive-on frames at the steady base level (start/stop ramps excluded), as a boolean Series."""
+    on = env["drive_on"].astype(bool)
+    ref = np.hypot(env["ref_re"], env["ref_im"])
+    level = np.median(ref[on]) if on.any() else np.nan
+    return on & (ref >= ramp_fraction * level)
+
+
+def plot_envelopes(table: pd.DataFrame, envs: dict[str, pd.DataFrame], path, ramp_fraction: float = 0.95) -> None:
     """Fig. 3.5: response envelopes versus drive frequency, one panel per assembly.
 
     Per level, the last downward sweep (the paper shows the down sweeps; the last of the
-    1 g repeats); a level without a down sweep shows its last run.
+    1 g repeats); a level without a down sweep shows its last run. The start and stop
+    ramps are left out: frames whose base (reference) amplitude is below `ramp_fraction`
+    of its median over the drive-on frames (there the level, not the joint, sets the
+    response, which would plot as vertical drops at the band's ends).
     """
     plt = _plt()
     level = next((c for c in ("level_g", "level_lbf", "level_V") if c in table.columns), "level_g")
@@ -47,9 +58,9 @@ def plot_envelopes(table: pd.DataFrame, envs: dict[str, pd.DataFrame], path) -> 
             e = envs.get(rid)
             if e is None or e.empty:
                 continue
-            e = e[e["drive_on"].astype(bool)]
+            e = e[steady_frames(e, ramp_fraction)]
             ax.plot(e["f_drive_hz"], np.hypot(e["resp_re"], e["resp_im"]), lw=1.2, label=f"{lev:g} {unit}")
-        ax.set_title(asm)
+        ax.set_title(f"{asm}: last down sweep per level, ramps trimmed")
         ax.set_xlabel("drive frequency (Hz)")
         ax.set_yscale("log")
         ax.grid(True, which="both", alpha=0.3)

@@ -1,0 +1,261 @@
+"""The report's opening summary and the run-generated parts of its captions.
+
+Pure functions from the stages' outputs to text and HTML:
+
+* `ga_best_point` -- the GA's own best individual (the polish may move far from it);
+* `bound_hits` -- parameters at a search bound;
+* `chain_status` -- one line per posterior: steps in units of tau, converged or why not;
+* `table_3_2_html` -- Table 3.2 with the GA best, the polished optimum and the posterior
+  side by side, bound hits, unconstrained parameters and separated modes marked;
+* `summary_html` -- the campaign, the flags counted, the convergence lines, the
+  constraints in words and Table 3.2, as one HTML fragment.
+"""
+from __future__ import annotations
+
+import html
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import pandas as pd
+
+from ..calibrate.space import LOG_SCALED, PARAMS, UNITS
+
+__all__ = ["rst_escape", "ga_best_point", "bound_hits", "chain_status", "table_3_2_html", "summary_html", "landing_html", "fmt"]
+
+
+def rst_escape(text: str) -> str:
+    """Text safe to include in a reStructuredText caption (no inline markup, substitutions or references)."""
+    for ch in ("\\", "*", "`", "|", "_", "[", "]"):
+        text = text.replace(ch, "\\" + ch)
+    return text
+
+
+def fmt(v: float) -> str:
+    """A number in 3-4 significant digits (exponent form outside 1e-3..1e4)."""
+    if v is None or not np.isfinite(v):
+        return "-"
+    if v == 0 or 1e-3 <= abs(v) < 1e4:
+        return f"{v:.4g}" if abs(v) >= 1 else f"{v:.3g}"
+    mant, exp = f"{v:.3e}".split("e")
+    return f"{float(mant):.3g}e{int(exp)}"
+
+
+def ga_best_point(history: pd.DataFrame) -> dict[str, float]:
+    """The GA's best evaluated individual (``ga_history.csv``: objective and the six parameters)."""
+    row = history.loc[history["objective"].idxmin()]
+    return {p: float(row[p]) for p in PARAMS} | {"objective": float(row["objective"])}
+
+
+def bound_hits(theta: Mapping[str, float], bounds: Mapping[str, Sequence[float]], tol: float = 1e-3) -> dict[str, str]:
+    """Parameters within `tol` of a bound (in decades for log-scaled ones, as a fraction of the range for chi).
+
+    Returns
+    -------
+    dict
+        param -> "lower" or "upper".
+    """
+    hits = {}
+    for p in PARAMS:
+        lo, hi = (float(b) for b in bounds[p])
+        v = float(theta[p])
+        if LOG_SCALED.get(p, True):
+            d_lo, d_hi = np.log10(v / lo), np.log10(hi / v)
+        else:
+            d_lo, d_hi = (v - lo) / (hi - lo), (hi - v) / (hi - lo)
+        if d_lo <= tol:
+            hits[p] = "lower"
+        elif d_hi <= tol:
+            hits[p] = "upper"
+    return hits
+
+
+def _touches(p: str, q05: float, q95: float, bounds: Mapping[str, Sequence[float]], tol: float = 0.02) -> str | None:
+    """"lower"/"upper" when a 90% interval reaches within `tol` of the prior width of a bound, else None."""
+    lo, hi = (float(b) for b in bounds[p])
+    f = np.log10 if LOG_SCALED.get(p, True) else (lambda v: v)
+    w = f(hi) - f(lo)
+    if np.isfinite(q05) and f(q05) - f(lo) <= tol * w:
+        return "lower"
+    if np.isfinite(q95) and f(hi) - f(q95) <= tol * w:
+        return "upper"
+    return None
+
+
+def chain_status(z: Mapping, *, tau_factor: float = 50.0) -> tuple[bool, str]:
+    """Convergence of one posterior from its ``chain.npz`` arrays.
+
+    Returns
+    -------
+    converged : bool
+    line : str
+        E.g. "converged: 14000 steps = 52 tau" or "NOT converged: 6.2 tau (stopped early: ...)".
+    """
+    hist = np.asarray(z["tau_history"], dtype=float)
+    n, tau = hist[-1, 0], float(np.max(hist[-1, 1:]))
+    multiple = n / tau
+    converged = bool(z["converged"])
+    reason = str(z["stop_reason"]) if "stop_reason" in z else ("converged" if converged else "max_steps")
+    if converged:
+        return True, f"converged: {n:.0f} steps = {multiple:.1f} tau (tau {tau:.0f} steps)"
+    why = {"max_steps": "stopped at the step cap",
+           "projected": ("stopped early: 50 tau projected to need "
+                         + (f"{float(z['projected_steps']):.0f} steps" if np.isfinite(float(z.get(
+                             "projected_steps", np.inf))) else "more steps than any cap (tau grows with the chain)"))}
+    return False, (f"NOT converged: {multiple:.1f} tau of the {tau_factor:g} required ({n:.0f} steps, tau {tau:.0f}); "
+                   f"{why.get(reason, reason)}")
+
+
+_CSS = """<style>
+body{font-family:sans-serif;margin:1em}
+.jc-summary{font-size:14px;line-height:1.4}
+.jc-summary table{border-collapse:collapse;margin:0.4em 0 1em 0;font-size:13px}
+.jc-summary th,.jc-summary td{border:1px solid #bbb;padding:2px 6px;text-align:right;white-space:nowrap}
+.jc-summary th{background:#eee}
+.jc-summary td.lab{text-align:left}
+.jc-summary td.bound{background:#fde2c4}
+.jc-summary td.free{color:#777;font-style:italic}
+.jc-summary .bad{color:#b00000;font-weight:bold}
+.jc-summary .good{color:#006400;font-weight:bold}
+</style>"""
+
+
+def _cell(text: str, cls: str = "") -> str:
+    return f'<td class="{cls}">{text}</td>' if cls else f"<td>{text}</td>"
+
+
+def table_3_2_html(table: pd.DataFrame, ga_points: Mapping[str, Mapping[str, float]],
+                   modes: Mapping[str, pd.DataFrame] | None = None,
+                   bounds: Mapping[str, Sequence[float]] | None = None) -> str:
+    """Table 3.2 as an HTML table: per assembly, GA best, polished optimum, posterior, and each mode.
+
+    Parameters
+    ----------
+    table : DataFrame
+        `jointcal.report.tables.table_3_2` (its ga_optimum column is the polished optimum).
+    ga_points : mapping assembly -> dict
+        `ga_best_point` of each assembly.
+    modes : mapping assembly -> DataFrame, optional
+        `jointcal.posterior.find_modes` tables; with two or more modes each gets a row.
+    bounds : mapping param -> (lo, hi), optional
+        Search bounds: values at a bound are marked.
+    """
+    head = "".join(f"<th>{p} ({html.escape(UNITS[p])})</th>" for p in PARAMS)
+    rows = [f"<table><tr><th>assembly</th><th>estimate</th>{head}</tr>"]
+    for name, g in table.groupby("assembly", sort=False):
+        g = g.set_index("param")
+        polished = {p: float(g.loc[p, "ga_optimum"]) for p in PARAMS}
+        m = None if modes is None else modes.get(name)
+        n_modes = 0 if m is None or m.empty else int(m["mode"].max()) + 1
+        lines = [("GA best (before polish)", ga_points[name]), ("polished optimum", polished)]
+        for label, point in lines:
+            hits = bound_hits(point, bounds) if bounds else {}
+            cells = [_cell(fmt(point[p]) + (f" ({hits[p]} bound)" if p in hits else ""), "bound" if p in hits else "")
+                     for p in PARAMS]
+            rows.append(f"<tr><td class='lab'>{html.escape(name)}</td><td class='lab'>{label}</td>{''.join(cells)}</tr>")
+        cells = []
+        for p in PARAMS:
+            r = g.loc[p]
+            free = r["constrained"] is False or r["constrained"] == False  # noqa: E712
+            text = f"{fmt(r['posterior_median'])} [{fmt(r['posterior_q05'])}, {fmt(r['posterior_q95'])}]"
+            edge = _touches(p, r["posterior_q05"], r["posterior_q95"], bounds) if bounds else None
+            note = f" (touches {edge} bound)" if edge else ""
+            cells.append(_cell(text + ("*" if free else "") + note, "bound" if edge else ("free" if free else "")))
+        label = "posterior median [q05, q95]" + (" <span class='bad'>(between modes)</span>" if n_modes > 1 else "")
+        rows.append(f"<tr><td class='lab'>{html.escape(name)}</td><td class='lab'>{label}</td>{''.join(cells)}</tr>")
+        for k in range(n_modes if n_modes > 1 else 0):
+            mk = m[m["mode"] == k].set_index("param")
+            cells = [_cell(f"{fmt(mk.loc[p, 'median'])} [{fmt(mk.loc[p, 'q05'])}, {fmt(mk.loc[p, 'q95'])}]")
+                     for p in PARAMS]
+            w = 100 * float(mk["weight"].iloc[0])
+            rows.append(f"<tr><td class='lab'>{html.escape(name)}</td><td class='lab'>mode {k + 1} ({w:.0f}% of the "
+                        f"draws)</td>{''.join(cells)}</tr>")
+    rows.append("</table>")
+    rows.append("<p>* not constrained by the data (posterior 90% interval spans at least half the prior range). "
+                "Orange: at a search bound. The GA best is the GA's own best individual; the polished optimum is "
+                "what least squares made of the best distinct individuals (<code>ga_best.json</code>) and is where the "
+                "posterior starts.</p>")
+    return "\n".join(rows)
+
+
+def summary_html(*, campaign: str, runs: pd.DataFrame, modal: pd.DataFrame, status: Mapping[str, tuple[bool, str]],
+                 constraints: Mapping[str, str], table_html: str, fits: Mapping[str, str] | None = None) -> str:
+    """The report's opening summary as an HTML fragment.
+
+    Parameters
+    ----------
+    campaign : str
+        The campaign folder.
+    runs : DataFrame
+        ``runs.csv`` of the ingest stage (run_id, assembly, flags, ...).
+    modal : DataFrame
+        ``modal_properties.csv`` (run_id, assembly, flags).
+    status : mapping assembly -> (converged, line)
+        `chain_status` of each posterior.
+    constraints : mapping assembly -> str
+        ``constraints.txt`` of each posterior (its sentences are listed).
+    table_html : str
+        `table_3_2_html`.
+    fits : mapping assembly -> str, optional
+        Extra sentences per assembly.
+    """
+    out = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>jointcal summary</title>", _CSS,
+           "</head><body>", '<div class="jc-summary">', "<h2>jointcal: summary of this run</h2>"]
+    n_asm = runs["assembly"].nunique() if "assembly" in runs else 0
+    level = "level_g" if "level_g" in runs.columns else ("level_lbf" if "level_lbf" in runs.columns else None)
+    levels = "" if level is None else ", levels " + ", ".join(f"{v:g}" for v in sorted(runs[level].dropna().unique()))
+    out.append(f"<p><b>Campaign</b> <code>{html.escape(campaign)}</code>: {len(runs)} runs on {n_asm} assemblies"
+               f"{html.escape(levels)}{' g' if level == 'level_g' else (' lbf' if level else '')}.</p>")
+    flag_rows = []
+    for label, t in (("ingest (runs.csv)", runs), ("modal (modal_properties.csv)", modal)):
+        n, detail = _flag_counts(t)
+        flag_rows.append(f"<li>{label}: <b>{n}</b> of {len(t)} runs flagged"
+                         + (f" ({html.escape(detail)})" if detail else "") + "</li>")
+    out.append("<p><b>Run flags</b></p><ul>" + "".join(flag_rows) + "</ul>")
+    out.append("<p><b>Posterior convergence</b></p><ul>")
+    for name, (ok, line) in status.items():
+        cls = "good" if ok else "bad"
+        out.append(f"<li>{html.escape(name)}: <span class='{cls}'>{html.escape(line)}</span></li>")
+    out.append("</ul>")
+    out.append("<p><b>Table 3.2</b> (the paper's calibrated parameters)</p>")
+    out.append(table_html)
+    for name, text in constraints.items():
+        out.append(f"<p><b>What the data constrain: {html.escape(name)}</b></p><ul>")
+        out.extend(f"<li>{html.escape(s)}</li>" for s in text.strip().splitlines() if s.strip())
+        if fits and name in fits:
+            out.append(f"<li>{html.escape(fits[name])}</li>")
+        out.append("</ul>")
+    out.append("</div></body></html>")
+    return "\n".join(out) + "\n"
+
+
+def _flag_counts(t: pd.DataFrame) -> tuple[int, str]:
+    f = t["flags"].fillna("").astype(str) if "flags" in t else pd.Series([], dtype=str)
+    flagged = f[f.str.strip() != ""]
+    kinds: dict[str, int] = {}
+    for v in flagged:
+        for k in v.replace(",", ";").split(";"):
+            k = k.strip().split(":")[0].split("(")[0].strip()
+            if k:
+                kinds[k] = kinds.get(k, 0) + 1
+    return len(flagged), "; ".join(f"{k}: {n}" for k, n in sorted(kinds.items()))
+
+
+def landing_html(*, runs: pd.DataFrame, modal: pd.DataFrame, status: Mapping[str, tuple[bool, str]],
+                 notes: Mapping[str, Sequence[str]] | None = None) -> str:
+    """A few lines for the report's landing page: run flags counted and each posterior's convergence.
+
+    Short on purpose: Snakemake's landing page centres its content and clips a long one.
+    ``notes`` adds short warnings per assembly (e.g. multimodal, a parameter at a bound).
+    """
+    out = ['<div style="font-size:13px;line-height:1.35">']
+    for label, t in (("ingest", runs), ("modal", modal)):
+        n, detail = _flag_counts(t)
+        out.append(f"<div>Run flags, {label}: <b>{n}</b> of {len(t)} runs"
+                   + (f" ({html.escape(detail)})" if detail else "") + "</div>")
+    for name, (ok, line) in status.items():
+        colour = "#006400" if ok else "#b00000"
+        extra = "".join(f"; {html.escape(n)}" for n in (notes or {}).get(name, ()))
+        out.append(f"<div>Posterior <b>{html.escape(name)}</b>: <span style='color:{colour};font-weight:bold'>"
+                   f"{html.escape(line)}</span>{extra}</div>")
+    out.append("</div>")
+    return "\n".join(out) + "\n"

@@ -1,0 +1,115 @@
+"""Report pieces: mode detection with a known answer, chain status lines, Table 3.2 in HTML, stamped figures."""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from jointcal.calibrate import PARAMS, CalibrateSettings
+from jointcal.posterior import find_modes, mode_labels, modes_text
+from jointcal.report.calibration import corner_figure, exploration_figure
+from jointcal.report.modal import steady_frames
+from jointcal.report.summary import bound_hits, chain_status, ga_best_point, landing_html, table_3_2_html
+
+BOUNDS = {k: list(v) for k, v in CalibrateSettings().bounds.items()}
+
+
+def _bimodal(n=12000, weight=0.3, sep=6.0, seed=1):
+    rng = np.random.default_rng(seed)
+    x = rng.standard_normal((n, 8))
+    second = rng.random(n) < weight
+    x[second, 0] += sep  # separated along one coordinate ...
+    x[:, 3] = rng.uniform(0, 1, n)  # ... with a flat (unconstrained) coordinate alongside
+    return x, second
+
+
+def test_modes_of_a_bimodal_sample_have_the_known_weights_and_locations():
+    x, second = _bimodal()
+    m = find_modes(x, [f"p{i}" for i in range(8)]).set_index(["mode", "param"])
+    assert m.index.get_level_values("mode").max() == 1
+    # weights within 0.02 of 0.7 / 0.3 (binomial sd 0.004 at n = 12000; the cut misassigns < 0.1% at 6 sd)
+    assert m.loc[(0, "p0"), "weight"] == pytest.approx(0.7, abs=0.02)
+    assert m.loc[(1, "p0"), "weight"] == pytest.approx(0.3, abs=0.02)
+    # each mode's median sits at its centre (sd of a median of >= 3600 unit-normal draws: 0.02)
+    assert m.loc[(0, "p0"), "median"] == pytest.approx(0.0, abs=0.1)
+    assert m.loc[(1, "p0"), "median"] == pytest.approx(6.0, abs=0.1)
+    assert np.mean(mode_labels(x)[second] == 1) > 0.99
+    text = modes_text(find_modes(x, [f"p{i}" for i in range(8)]), ["p0"], converged=False)
+    assert "MULTIMODAL (2 separated modes" in text and "walkers started" in text
+
+
+def test_modes_along_a_diagonal_are_found_and_single_modes_are_not_split():
+    rng = np.random.default_rng(2)
+    x = rng.standard_normal((12000, 8))
+    second = rng.random(12000) < 0.4
+    x[second, :2] += 4.0  # separated only along p0 + p1 (2.8 sd in each marginal)
+    assert np.bincount(mode_labels(x)).tolist() == pytest.approx([12000 - second.sum(), second.sum()], abs=60)
+    for sample in (rng.standard_normal((12000, 8)), rng.uniform(0, 1, (12000, 8))):  # one Gaussian, one flat box
+        assert mode_labels(sample).max() == 0
+    banana = rng.standard_normal((12000, 8))
+    banana[:, 1] = banana[:, 0] ** 2 + 0.1 * banana[:, 1]  # curved but single
+    assert mode_labels(banana).max() == 0
+
+
+def test_chain_status_states_the_tau_multiple_and_why_it_stopped():
+    hist = np.array([[1000, 100, 90], [2000, 150, 140], [6000, 586, 500]], dtype=float)
+    ok, line = chain_status(dict(tau_history=hist, converged=False, stop_reason="projected", projected_steps=62160.0))
+    assert not ok and line.startswith("NOT converged: 10.2 tau of the 50 required") and "62160 steps" in line
+    ok, line = chain_status(dict(tau_history=np.array([[14000, 270, 200]], float), converged=True,
+                                 stop_reason="converged", projected_steps=14000.0))
+    assert ok and line.startswith("converged: 14000 steps = 51.9 tau")
+
+
+def _table(zeta_v=1e-4):
+    rows = []
+    for p in PARAMS:
+        v = {"Fs": 36.6, "KT": 5.1e5, "chi": -0.65, "beta": 0.135, "k": 1e6, "zeta_v": zeta_v}[p]
+        rows.append(dict(assembly="first", param=p, unit="-", ga_optimum=v, posterior_median=v,
+                         posterior_q05=v / 2 if p != "chi" else v - 0.01, posterior_q95=v * 2 if p != "chi" else v + 0.01,
+                         width_ratio=0.8 if p == "beta" else 0.1, constrained=p != "beta"))
+    return pd.DataFrame(rows)
+
+
+def test_table_3_2_html_marks_bounds_unconstrained_parameters_and_modes():
+    history = pd.DataFrame({"generation": [0, 1], "objective": [3.0, 2.0], "Fs": [10.0, 42.1], "KT": [1e5, 4.6e5],
+                            "chi": [-0.5, -0.59], "beta": [0.1, 0.0013], "k": [1e5, 9.97e5], "zeta_v": [0.01, 0.0019]})
+    ga = ga_best_point(history)
+    assert ga["Fs"] == 42.1 and ga["objective"] == 2.0
+    modes = pd.DataFrame([dict(mode=k, weight=w, param=p, median=m, q05=m, q95=m) for k, (w, m) in
+                          enumerate([(0.87, 1561.0), (0.13, 37.3)]) for p in PARAMS])
+    html = table_3_2_html(_table(), {"first": ga}, {"first": modes}, BOUNDS)
+    assert html.count("<tr>") == 1 + 5  # header, GA best, polished, posterior, two modes
+    assert "42.1" in html and "1e-4 (lower bound)" in html and "class=\"bound\"" in html
+    assert "0.135 [0.0675, 0.27]*" in html  # beta unconstrained
+    assert "(between modes)" in html and "mode 2 (13% of the draws)" in html
+    assert bound_hits({p: v for p, v in zip(PARAMS, [36.6, 5.1e5, -0.65, 0.135, 1e6, 1e-4])}, BOUNDS) == {
+        "zeta_v": "lower"}
+    page = landing_html(runs=pd.DataFrame({"run_id": ["a", "b"], "flags": ["", "clipped; snr"]}),
+                        modal=pd.DataFrame({"run_id": ["a", "b"], "flags": ["", "unusable"]}),
+                        status={"first": (False, "NOT converged: 10.2 tau")}, notes={"first": ["MULTIMODAL (2 modes)"]})
+    assert "<b>1</b> of 2 runs (clipped: 1; snr: 1)" in page and "NOT converged: 10.2 tau" in page
+
+
+def test_figures_carry_the_status_points_and_a_colour_bar():
+    x, _ = _bimodal(n=4000)
+    png = corner_figure(x[:, :3], ["a", "b", "c"], points={"GA best": [0.0, 0.0, 0.5], "polished optimum": [6, 0, 0.5]},
+                        bounds=([-5, -5, 0], [10, 5, 1]), modes=mode_labels(x[:, :3]),
+                        stamp=("NOT converged: 10.2 tau", False))
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 20_000
+    rng = np.random.default_rng(0)
+    h = pd.DataFrame({p: 10 ** rng.uniform(*np.log10(BOUNDS[p]), 300) if p != "chi" else rng.uniform(-0.95, 0, 300)
+                      for p in PARAMS})
+    h.insert(0, "objective", 10 ** rng.uniform(-5, 1, 300))
+    h.insert(0, "generation", 0)
+    best = ga_best_point(h)
+    png = exploration_figure(h, title="t", ga_best=best, polished=best, bounds=BOUNDS)
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_ramps_are_trimmed_from_the_envelopes():
+    n = 200
+    ref = np.r_[np.linspace(0.1, 1.0, 20), np.ones(n - 40), np.linspace(1.0, 0.1, 20)]  # start and stop ramps
+    env = pd.DataFrame({"drive_on": True, "ref_re": ref, "ref_im": 0.0})
+    keep = steady_frames(env).to_numpy()
+    assert keep[20:n - 20].all()  # the steady sweep is kept
+    assert not keep[:18].any() and not keep[-18:].any()  # ramp frames below 95% of the level are dropped
