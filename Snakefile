@@ -32,6 +32,7 @@ include: "workflow/rules/modal.smk"
 include: "workflow/rules/calibrate.smk"
 include: "workflow/rules/posterior.smk"
 include: "workflow/rules/validate.smk"
+include: "workflow/rules/discrepancy.smk"
 
 
 rule all:
@@ -42,3 +43,4 @@ rule all:
         rules.calibrate.input,
         rules.posterior.input,
         rules.validate.input,
+        rules.discrepancy.input,

@@ -77,26 +77,23 @@ def _stiffness(q, s, w, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights
             Dq = 4.0 * p / (PI * (chi + 2.0) * (chi + 3.0))  # D(q)/(pi q^2), D = 4 R q^(chi+3)/((chi+2)(chi+3))
             im += Dq
             dim += e * Dq
-        else:  # macroslip: finite differences in s of the exact describing function
-            h = 1e-6
-            vals = np.empty(4)
-            for j in range(2):
-                qq = q * np.exp(h if j == 0 else -h)
-                sm = phimax / qq
-                kin = KT - R * qq**e * _J(chi, sm, nodes, weights) - S * (1.0 - _jenkins(sm))
-                u = phimax
-                D = 4.0 * R * (qq * u ** (chi + 2.0) / (chi + 2.0) - u ** (chi + 3.0) / (chi + 3.0))
-                D += 4.0 * S * phimax * (qq - phimax)
-                vals[2 * j] = kin
-                vals[2 * j + 1] = D / (PI * qq * qq)
+        else:  # macroslip (eqs. 3.3-3.7 with the delta S at phi_max): exact derivatives in q
             sm = phimax / q
-            re += KT - R * q**e * _J(chi, sm, nodes, weights) - S * (1.0 - _jenkins(sm))
+            qe = R * np.exp(e * s)
+            J = _J(chi, sm, nodes, weights)
+            g = _jenkins(sm)
+            re += KT - qe * J - S * (1.0 - g)
+            dJ = (1.0 - g) * sm**chi  # dJ/dsmax: the integrand at the upper limit
+            th = np.arccos(1.0 - 2.0 * sm)
+            dg = 4.0 * np.sin(th) / PI  # dg/ds
+            # q d/dq: smax = phimax/q moves as -smax
+            dre -= e * qe * J - qe * dJ * sm + S * dg * sm
             u = phimax
             D = 4.0 * R * (q * u ** (chi + 2.0) / (chi + 2.0) - u ** (chi + 3.0) / (chi + 3.0))
             D += 4.0 * S * phimax * (q - phimax)
+            dD = 4.0 * R * u ** (chi + 2.0) / (chi + 2.0) + 4.0 * S * phimax  # dD/dq
             im += D / (PI * q * q)
-            dre += (vals[0] - vals[2]) / (2.0 * h)
-            dim += (vals[1] - vals[3]) / (2.0 * h)
+            dim += (q * dD - 2.0 * D) / (PI * q * q)
     if k3 != 0.0:
         t = 0.75 * k3 * q * q  # cubic spring: 3/4 k3 q^2 in phase
         re += t
@@ -177,10 +174,44 @@ def _root(s0, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, k3, c2, n
     return s, jumped, re, im
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
 def solve(w, mu_re, mu_im, logB, s_start, order, kp, c, KT, R, chi, phimax, S, J1, k3, c2,
           nodes, weights, tol, s_out, jump_out, kre_out, kim_out):
     """Amplitudes s = log q (P, N) by continuation along `order` for every parameter set.
+
+    w (N,) rad/s; mu_re, mu_im, logB (P, N); s_start (P,) a guess for the first
+    frequency (below every branch for an up sweep's low end, see `envelope`); parameter
+    arrays (P,). Writes s_out, jump_out and the joint DOF's dynamic stiffness at the
+    solution (kre_out + i kim_out, lbf/in), all (P, N).
+    """
+    P = mu_re.shape[0]
+    N = w.shape[0]
+    for p in range(P):
+        s = s_start[p]
+        s_prev = s
+        for jj in range(N):
+            n = order[jj]
+            guess = s
+            if jj >= 2:  # continue the branch by linear extrapolation in frequency
+                n1 = order[jj - 1]
+                n2 = order[jj - 2]
+                if w[n1] != w[n2]:
+                    guess = s + (s - s_prev) * (w[n] - w[n1]) / (w[n1] - w[n2])
+            s_prev = s
+            s, jumped, re, im = _root(guess, w[n], mu_re[p, n], mu_im[p, n], logB[p, n], kp[p], c[p], KT[p], R[p],
+                                      chi[p], phimax[p], S[p], J1[p], k3[p], c2[p], nodes, weights, tol)
+            s_out[p, n] = s
+            jump_out[p, n] = jumped and jj > 0
+            kre_out[p, n] = re
+            kim_out[p, n] = im
+
+
+@njit(cache=True, parallel=True)
+def solve_parallel(w, mu_re, mu_im, logB, s_start, order, kp, c, KT, R, chi, phimax, S, J1, k3, c2,
+          nodes, weights, tol, s_out, jump_out, kre_out, kim_out):
+    """`solve` with the parameter sets spread over threads (for large batches).
+
+    Amplitudes s = log q (P, N) by continuation along `order` for every parameter set.
 
     w (N,) rad/s; mu_re, mu_im, logB (P, N); s_start (P,) a guess for the first
     frequency (below every branch for an up sweep's low end, see `envelope`); parameter

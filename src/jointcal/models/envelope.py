@@ -168,7 +168,8 @@ def steady_state(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike = 1.0
     s = np.empty((P, f.size))
     jump = np.zeros((P, f.size), dtype=np.bool_)
     kre, kim = np.empty((P, f.size)), np.empty((P, f.size))
-    _k.solve(w, np.ascontiguousarray(mu.real), np.ascontiguousarray(mu.imag), np.ascontiguousarray(logB), s0,
+    solver = _k.solve_parallel if P >= 64 else _k.solve  # threads pay off only for large batches
+    solver(w, np.ascontiguousarray(mu.real), np.ascontiguousarray(mu.imag), np.ascontiguousarray(logB), s0,
              order.astype(np.int64), k, c, KT, R, chi, phimax, S, J1, k3, c2, _NODES, _WEIGHTS, TOL, s, jump,
              kre, kim)
     q = np.exp(s)

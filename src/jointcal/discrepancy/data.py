@@ -1,0 +1,91 @@
+"""Measured envelopes of one assembly, as the discrepancy fits use them.
+
+Per usable run: the frames of its envelopes (drive on, not bad, at full drive, within
+a band around the measured resonance), their drive frequency, base amplitude, measured
+transmissibility response/base, the signed sweep rate, and the repeat-scatter scale of
+each frame's magnitude (dB) and phase (deg), the same bins as the validation error E
+(`jointcal.validate.error`).
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from numpy.typing import NDArray
+
+from ..validate.error import BINS
+
+__all__ = ["RunEnvelope", "run_envelope", "scale_arrays"]
+
+
+@dataclass(frozen=True)
+class RunEnvelope:
+    """One run's measured envelope frames (all arrays shape (n,)).
+
+    f_hz : drive frequency, Hz; base_g : base amplitude, g; T : measured transmissibility;
+    sigma_db, sigma_deg : repeat scatter of magnitude and phase at each frame; rate : signed
+    sweep rate df/dt, Hz/s; row : the manifest/modal row (run_id, level_g, direction,
+    sequence, f_res_hz, zeta_phase_resonance, ...).
+    """
+
+    f_hz: NDArray[np.float64]
+    base_g: NDArray[np.float64]
+    T: NDArray[np.complex128]
+    sigma_db: NDArray[np.float64]
+    sigma_deg: NDArray[np.float64]
+    rate: float
+    row: dict
+
+
+def scale_arrays(scale: Sequence[Mapping] | pd.DataFrame | None, floor_db: float = 0.05,
+                 floor_deg: float = 0.3) -> tuple[NDArray, NDArray]:
+    """Per-bin scatter (dB, deg) from the validation's scale table, or the floors."""
+    n = len(BINS) - 1
+    if scale is None or len(scale) == 0:
+        return np.full(n, floor_db), np.full(n, floor_deg)
+    t = pd.DataFrame(scale)
+    return t["sigma_mag_db"].to_numpy(float), t["sigma_phase_deg"].to_numpy(float)
+
+
+def run_envelope(env: pd.DataFrame, row: Mapping, sigma_db: NDArray, sigma_deg: NDArray, *,
+                 band: tuple[float, float] = (0.6, 1.4), max_frames: int = 160) -> RunEnvelope | None:
+    """The frames of one run used by the discrepancy fits (None when the run is unusable).
+
+    Parameters
+    ----------
+    env : DataFrame
+        The run's envelopes (`jointcal.signal.envelopes`).
+    row : mapping
+        Its modal row (f_res_hz, zeta_phase_resonance, flags) merged with the manifest row.
+    sigma_db, sigma_deg : ndarray, shape (len(BINS) - 1,)
+        Repeat scatter per bin of |x| = |f/f_res - 1| / zeta.
+    band : (lo, hi)
+        Frames kept, as fractions of the measured resonance (wider than E's band: the
+        gain, delay and fixture fingerprints live off resonance).
+    max_frames : int
+        Frames kept at most (evenly thinned): the fits' cost.
+    """
+    f_res = float(row.get("f_res_hz", np.nan))
+    zeta = float(row.get("zeta_phase_resonance", np.nan))
+    if not np.isfinite(zeta):
+        zeta = float(row.get("zeta_half_power", np.nan))
+    if not (np.isfinite(f_res) and np.isfinite(zeta) and zeta > 0) or "unusable" in str(row.get("flags", "")):
+        return None
+    ref = (env["ref_re"] + 1j * env["ref_im"]).to_numpy()
+    resp = (env["resp_re"] + 1j * env["resp_im"]).to_numpy()
+    f = env["f_drive_hz"].to_numpy(float)
+    ok = env["drive_on"].to_numpy(bool) & ~env["bad"].to_numpy(bool)
+    ok &= np.abs(ref) >= 0.8 * np.median(np.abs(ref[ok])) if ok.any() else ok
+    ok &= (f >= band[0] * f_res) & (f <= band[1] * f_res)
+    idx = np.flatnonzero(ok)
+    if idx.size < 8:
+        return None
+    idx = idx[np.unique(np.linspace(0, idx.size - 1, min(max_frames, idx.size)).round().astype(int))]
+    t = env["time_s"].to_numpy(float)
+    rate = float(np.median(np.gradient(f[ok], t[ok]))) if ok.sum() > 2 else 0.0
+    x = np.abs(f[idx] / f_res - 1.0) / zeta
+    b = np.clip(np.digitize(x, BINS[1:-1]), 0, len(BINS) - 2)
+    return RunEnvelope(f_hz=f[idx], base_g=np.abs(ref[idx]), T=resp[idx] / ref[idx], sigma_db=sigma_db[b],
+                       sigma_deg=sigma_deg[b], rate=rate, row=dict(row))

@@ -1,0 +1,144 @@
+"""Where measurement and model disagree: residual maps and the fingerprint features of each effect.
+
+Residuals are the measured transmissibility over the baseline model's (fast model, the
+sweep's first-order lag applied), in dB and degrees, divided by the repeat scatter of
+their bin. Fingerprints (PHYSICS.md, issue 9):
+
+==========================  ==========================================================  ==================
+feature                     how                                                         points at
+==========================  ==========================================================  ==================
+low_gain                    median |T_meas / T_model| below 0.85 f_res                  sensor_gain
+low_gain_trend              slope of ln|T_meas / T_model| against (f / f_res)^2 there   fixture_flexibility
+delay_us                    -slope of the phase residual (rad) against omega off         channel_delay
+                            resonance (|x| > 3), in microseconds
+peak_ratio                  measured / model peak response                              (all; the paper's
+                                                                                         under-prediction)
+f_trend_per_decade          slope of f_res,meas / f_model - 1 against log10 level        cubic_stiffening
+zeta_trend_per_decade       slope of zeta_meas / zeta_model - 1 against log10 level      quadratic_damping
+drift_sigma                 slope of f_res with run sequence at the most repeated level, joint_settling
+                            in repeat-scatter units over the span of the sequence
+h2_ratio, h3_ratio          median 2nd / 3rd harmonic over the fundamental at the top    contact (even),
+                            level                                                        cubic (odd)
+masing_ratio                measured (zeta - zeta_v)/(1 - f/f0) at the lowest level      quadratic_damping
+                            over its Iwan limit 4(chi+1)/(pi(chi+3))                      (> 1)
+==========================  ==========================================================  ==================
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import pandas as pd
+
+from .data import RunEnvelope
+from .fit import Candidate, predict
+
+__all__ = ["residual_map", "fingerprints", "verdicts"]
+
+
+def residual_map(c: Candidate, theta, runs: Sequence[RunEnvelope]) -> pd.DataFrame:
+    """Tidy residuals of one model: run_id, level, direction, sequence, f_hz, x, d_mag_db, d_phase_deg, z_mag, z_phase."""
+    rows = []
+    for run in runs:
+        d = run.T / predict(c, theta, run)  # measured over model
+        r = run.row
+        f_res = float(r["f_res_hz"])
+        rows.append(pd.DataFrame(dict(
+            run_id=r["run_id"], level=float(r.get("level_g", np.nan)), direction=r.get("direction", ""),
+            sequence=int(r.get("sequence", 0)), f_hz=run.f_hz, f_over_fres=run.f_hz / f_res,
+            d_mag_db=20 * np.log10(np.abs(d)), d_phase_deg=np.degrees(np.angle(d)),
+            z_mag=20 * np.log10(np.abs(d)) / run.sigma_db, z_phase=np.degrees(np.angle(d)) / run.sigma_deg)))
+    return pd.concat(rows, ignore_index=True)
+
+
+def _slope(x, y) -> float:
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    ok = np.isfinite(x) & np.isfinite(y)
+    if ok.sum() < 3 or np.ptp(x[ok]) == 0:
+        return float("nan")
+    return float(np.polyfit(x[ok], y[ok], 1)[0])
+
+
+def fingerprints(res: pd.DataFrame, modal: pd.DataFrame, model_fz: Mapping[str, tuple[float, float]],
+                 joint: Mapping[str, float], scatter_f: float, m: float) -> dict:
+    """The fingerprint features of one assembly (see the module table).
+
+    Parameters
+    ----------
+    res : DataFrame
+        `residual_map` of the baseline.
+    modal : DataFrame
+        The assembly's usable modal rows (run_id, level_g, sequence, f_res_hz,
+        zeta_phase_resonance, h2_ratio, h3_ratio).
+    model_fz : mapping run_id -> (f_hz, zeta)
+        The baseline's harmonic-balance frequency and damping at each run's measured amplitude.
+    joint : mapping
+        Baseline parameters (chi, k, KT, zeta_v).
+    scatter_f : float
+        Pooled relative repeat scatter of f_res.
+    m : float
+        Slug mass, lbf s^2/in.
+    """
+    out: dict[str, float] = {}
+    low = res[res["f_over_fres"] < 0.85]
+    out["low_gain"] = float(10 ** (low["d_mag_db"].median() / 20)) if len(low) else float("nan")
+    out["low_gain_trend"] = _slope(low["f_over_fres"] ** 2, low["d_mag_db"] * np.log(10) / 20) if len(low) else np.nan
+    off = res[np.abs(res["f_over_fres"] - 1) > 0.1]
+    out["delay_us"] = -_slope(2 * np.pi * off["f_hz"], np.radians(off["d_phase_deg"])) * 1e6 if len(off) else np.nan
+    mo = modal.copy()
+    mo["f_mod"] = [model_fz[r][0] for r in mo["run_id"]]
+    mo["z_mod"] = [model_fz[r][1] for r in mo["run_id"]]
+    lev = np.log10(mo["level_g"].astype(float))
+    out["f_trend_per_decade"] = _slope(lev, mo["f_res_hz"] / mo["f_mod"] - 1)
+    out["zeta_trend_per_decade"] = _slope(lev, mo["zeta_phase_resonance"] / mo["z_mod"] - 1)
+    counts = mo.groupby("level_g").size()
+    lv = counts.idxmax() if len(counts) else np.nan
+    rep = mo[mo["level_g"] == lv].sort_values("sequence")
+    if len(rep) >= 3 and scatter_f > 0:
+        s = _slope(rep["sequence"], rep["f_res_hz"] / rep["f_res_hz"].mean())
+        out["drift_sigma"] = float(s * np.ptp(rep["sequence"]) / scatter_f)
+    else:
+        out["drift_sigma"] = float("nan")
+    top = mo[mo["level_g"] == mo["level_g"].max()]
+    out["h2_ratio"] = float(top["h2_ratio"].median()) if "h2_ratio" in top else np.nan
+    out["h3_ratio"] = float(top["h3_ratio"].median()) if "h3_ratio" in top else np.nan
+    bot = mo[mo["level_g"] == mo["level_g"].min()]
+    chi = float(joint["chi"])
+    f0 = np.sqrt((joint["k"] + joint["KT"]) / m) / (2 * np.pi)
+    ratio = (bot["zeta_phase_resonance"] - joint["zeta_v"]) / (1 - bot["f_res_hz"] / f0)
+    out["masing_ratio"] = float(ratio.median() / (4 * (chi + 1) / (np.pi * (chi + 3)))) if len(bot) else np.nan
+    return {k: (float(v) if np.isfinite(v) else None) for k, v in out.items()}
+
+
+def verdicts(fp: Mapping[str, float | None], sigma_db: float, sigma_f: float) -> dict[str, dict[str, list[str]]]:
+    """Per library effect: the fingerprints that agree with it ('for') and that disagree ('against').
+
+    sigma_db : repeat scatter of the magnitude off resonance (dB); sigma_f : relative
+    repeat scatter of f_res. A feature counts when it exceeds 3x its scatter.
+    """
+    g = fp.get("low_gain")
+    gain_db = 20 * np.log10(g) if g else 0.0
+    tr = fp.get("low_gain_trend") or 0.0
+    dl = fp.get("delay_us") or 0.0
+    ft = fp.get("f_trend_per_decade") or 0.0
+    zt = fp.get("zeta_trend_per_decade") or 0.0
+    dr = fp.get("drift_sigma") or 0.0
+    ms = fp.get("masing_ratio") or 1.0
+    h2, h3 = fp.get("h2_ratio") or 0.0, fp.get("h3_ratio") or 0.0
+    say = {
+        "sensor_gain": (abs(gain_db) > 3 * sigma_db, f"response/base far below resonance is {gain_db:+.2f} dB off the model"),
+        "channel_delay": (abs(dl) > 3.0, f"the phase error grows as 2 pi f tau with tau = {dl:.1f} us"),
+        "fixture_flexibility": (tr > 0.02, f"the low-frequency gain error rises with (f/f_res)^2 (slope {tr:.3f})"),
+        "cubic_stiffening": (abs(ft) > 3 * sigma_f, f"the frequency residual changes by {ft * 100:+.2f}% per decade of level"),
+        "quadratic_damping": (zt > 0.05 or ms > 1.3,
+                              f"the damping residual changes by {zt * 100:+.1f}% per decade of level; Masing ratio {ms:.2f}"),
+        "joint_settling": (abs(dr) > 3.0, f"the repeated runs drift by {dr:+.1f} scatter units over the sequence"),
+    }
+    out = {}
+    for name, (hit, words) in say.items():
+        out[name] = {"for": [words] if hit else [], "against": [] if hit else [f"not seen: {words}"]}
+    if h2 > 2 * max(h3, 1e-12):
+        for name in out:
+            out[name]["against"].append(f"even harmonics dominate (h2 {h2:.3f} > 2 x h3 {h3:.3f}): an asymmetric "
+                                        "(contact) nonlinearity no library effect has")
+    return out

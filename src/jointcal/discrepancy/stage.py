@@ -1,0 +1,201 @@
+"""The discrepancy stage for one assembly: localise, score the library, decide, act, report.
+
+1. Localise: the baseline (the calibration's optimum, refit on the envelopes) against
+   the measured envelopes; residual map and fingerprints (`fingerprints`).
+2. Candidates: the baseline and every library effect (`library.EFFECTS`), each refit on
+   the envelopes through the fast model (`fit`), scored on held-out levels (`select`).
+3. Decide by `select.decide`'s rule.
+4. Act: the named effect's model, fitted jointly with the joint parameters (bounded
+   least squares from the GA optimum; approximate 90% intervals from the Gauss-Newton
+   covariance), revalidated by the TIME simulation driven by each run's measured base
+   record (`jointcal.validate.validate_runs`, the validation stage's E: same definition,
+   same runs) -> metric_before, metric_after.
+"""
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from ..calibrate.space import PARAMS, ParamSpace
+from ..models import harmonic_balance
+from ..validate import ValidateSettings, model_from_best, validate_runs
+from .data import run_envelope, scale_arrays
+from .fingerprints import fingerprints, residual_map, verdicts
+from .fit import candidate, model_at
+from .library import EFFECTS
+from .select import CLOSE_FRACTION, MARGIN, NONE_E, decide, score_candidates
+
+__all__ = ["DiscrepancySettings", "diagnose"]
+
+
+@dataclass(frozen=True)
+class DiscrepancySettings:
+    """The ``discrepancy:`` config section: candidates (library names), band (fractions of f_res),
+    max_frames per run, max_nfev of each least-squares fit."""
+
+    candidates: tuple[str, ...] = tuple(EFFECTS)
+    band: tuple[float, float] = (0.6, 1.4)
+    max_frames: int = 80
+    max_nfev: int = 25
+
+    def __post_init__(self) -> None:
+        bad = [c for c in self.candidates if c not in EFFECTS]
+        if bad:
+            raise ValueError(f"discrepancy.candidates: unknown effect(s) {', '.join(bad)}; the library has "
+                             f"{', '.join(EFFECTS)}.")
+        if not (0 < self.band[0] < 1 < self.band[1]):
+            raise ValueError(f"discrepancy.band must be [lo, hi] with 0 < lo < 1 < hi, got {list(self.band)!r}.")
+        if self.max_frames < 16 or self.max_nfev < 5:
+            raise ValueError("discrepancy.max_frames must be >= 16 and max_nfev >= 5, got "
+                             f"{self.max_frames!r} and {self.max_nfev!r}.")
+
+    @classmethod
+    def from_config(cls, section: Mapping | None) -> DiscrepancySettings:
+        section = dict(section or {})
+        unknown = sorted(set(section) - {"candidates", "band", "max_frames", "max_nfev"})
+        if unknown:
+            raise ValueError(f"discrepancy: unknown key(s) {', '.join(unknown)}")
+        for key in ("candidates", "band"):
+            if key in section:
+                section[key] = tuple(section[key])
+        return cls(**section)
+
+
+def _interval(fit, c, i) -> list[float]:
+    """Approximate 90% interval of parameter i (physical units) from the unit-cube covariance."""
+    sd = np.sqrt(max(fit.cov_unit[i, i], 0.0))
+    u = c.to_unit(fit.theta)
+    lo, hi = u.copy(), u.copy()
+    lo[i] = max(0.0, u[i] - 1.645 * sd)
+    hi[i] = min(1.0, u[i] + 1.645 * sd)
+    return [float(c.to_physical(lo)[i]), float(c.to_physical(hi)[i])]
+
+
+def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFrame, best: Mapping,
+             scale: Sequence[Mapping] | None, records: Sequence[pd.DataFrame], rows: Sequence[Mapping], *,
+             space: ParamSpace, settings: DiscrepancySettings = DiscrepancySettings(),
+             validate_settings: ValidateSettings = ValidateSettings(), envelopes_kw: dict | None = None,
+             modal_kw: dict | None = None, metric_before: float | None = None, executor=None,
+             log: Callable[[str], None] | None = None) -> dict:
+    """Diagnose one assembly; returns the diagnosis (diagnosis.json's content plus tables and models).
+
+    Parameters
+    ----------
+    envs : run_id -> envelopes DataFrame; modal : modal_properties.csv rows (all assemblies);
+    best : the calibration's ga_best.json; scale : the validation's repeat-scatter bins
+    (summary.json's "scale"); records, rows : measured records and manifest rows of the
+    assembly's runs (for the time-simulation revalidation); metric_before : the validation
+    stage's E (recomputed when None).
+    """
+    say = log or (lambda s: None)
+    t_start = time.perf_counter()
+    m = float(best["m"])
+    theta0 = np.array([best[p] for p in PARAMS], dtype=float)
+    sdb, sdeg = scale_arrays(scale)
+    mrows = modal[modal["assembly"] == assembly].set_index("run_id")
+    runs = []
+    for row in rows:
+        rid = row["run_id"]
+        if rid not in mrows.index or rid not in envs:
+            continue
+        r = run_envelope(envs[rid], {**dict(row), **mrows.loc[rid].to_dict(), "run_id": rid}, sdb, sdeg,
+                         band=settings.band, max_frames=settings.max_frames)
+        if r is not None:
+            runs.append(r)
+    if len(runs) < 2:
+        raise ValueError(f"assembly {assembly}: {len(runs)} usable run(s); the discrepancy workflow needs at "
+                         "least two usable runs (at two levels to score held-out levels).")
+    say(f"{assembly}: {len(runs)} usable runs, {sum(r.f_hz.size for r in runs)} envelope frames")
+    cands = [candidate("baseline", space, m)] + [candidate(n, space, m) for n in settings.candidates]
+    scored = score_candidates(cands, runs, theta0, max_nfev=settings.max_nfev, log=say)
+    effect, confidence, ranked = decide(scored)
+    base = next(s for s in scored if s.name == "baseline")
+    # localise: residuals of the baseline refit, fingerprints
+    c0 = cands[0]
+    res = residual_map(c0, base.fit.theta, runs)
+    usable = mrows.loc[[r.row["run_id"] for r in runs]].reset_index()
+    jb = dict(zip(PARAMS, base.fit.theta))
+    model_fz = {}
+    for r in usable.itertuples():
+        f, z = harmonic_balance(r.q_in, jb["Fs"], jb["KT"], jb["chi"], jb["beta"], jb["k"], m, jb["zeta_v"])
+        model_fz[r.run_id] = (float(f), float(z))
+    sf = usable.groupby("level_g")["f_res_hz"].std().dropna() / usable["f_res_hz"].mean()
+    scatter_f = float(np.sqrt(np.mean(sf**2))) if len(sf) else 1e-4
+    fp = fingerprints(res, usable, model_fz, jb, max(scatter_f, 2e-5), m)
+    ver = verdicts(fp, float(sdb[-1]), max(scatter_f, 2e-5))
+    cand_out = []
+    for s in ranked:
+        c = candidate(s.name, space, m)
+        eff = {p.name: {"value": float(s.fit.theta[6 + i]), "unit": p.unit,
+                        "interval_90": _interval(s.fit, c, 6 + i)} for i, p in enumerate(c.effect_params)}
+        cand_out.append({"name": s.name, "held_out_score": s.score, "E_fit": s.fit.E,
+                         "held_out_E_per_level": s.held_out, "effect_parameters": eff,
+                         "joint_parameters": dict(zip(PARAMS, map(float, s.fit.theta[:6]))),
+                         "fingerprints_for": ver[s.name]["for"], "fingerprints_against": ver[s.name]["against"],
+                         "seconds": s.seconds})
+    # act: the named effect's model, revalidated in the time domain
+    named = next((s for s in ranked if s.name == effect), None)
+    final = named if named is not None else base
+    cf = candidate(final.name, space, m)
+    models_after = {r["run_id"]: model_at(cf, final.fit.theta, r) for r in rows}
+    say(f"{assembly}: decision {effect} ({confidence}); revalidating with the time simulation")
+    v_after = validate_runs([models_after[r["run_id"]] for r in rows], records, rows, settings=validate_settings,
+                            envelopes_kw=envelopes_kw, modal_kw=modal_kw, executor=executor)
+    if metric_before is None:
+        v_before = validate_runs([model_from_best(best) for _ in rows], records, rows, settings=validate_settings,
+                                 envelopes_kw=envelopes_kw, modal_kw=modal_kw, executor=executor)
+        metric_before = float(v_before.error["E"])
+    metric_after = float(v_after.error["E"])
+    joint_after = {p: {"value": float(final.fit.theta[i]), "interval_90": _interval(final.fit, cf, i)}
+                   for i, p in enumerate(PARAMS)}
+    diagnosis = {
+        "assembly": assembly, "effect": effect, "confidence": confidence,
+        "rule": (f"none if the baseline's held-out score <= {NONE_E}; else name the best candidate if it closes "
+                 f">= {CLOSE_FRACTION:.0%} of the baseline's excess over 1 and scores <= {MARGIN} x the runner-up "
+                 "(confidence high when its score <= 2); otherwise unexplained"),
+        "baseline": {"held_out_score": base.score, "E_fit": base.fit.E, "held_out_E_per_level": base.held_out,
+                     "joint_parameters": dict(zip(PARAMS, map(float, base.fit.theta[:6])))},
+        "candidates": cand_out, "fingerprints": fp,
+        "metric_before": float(metric_before), "metric_after": metric_after,
+        "metric_change": metric_after / metric_before - 1.0 if metric_before else None,
+        "recalibrated": {"model": final.name, "joint_parameters": joint_after,
+                         "effect_parameters": (cand_out[ranked.index(named)]["effect_parameters"]
+                                               if named is not None else {})},
+        "calibration_joint_parameters": dict(zip(PARAMS, map(float, theta0))),
+        "words_after": v_after.words, "seconds": time.perf_counter() - t_start,
+    }
+    return {"diagnosis": diagnosis, "residuals": res, "validation_after": v_after}
+
+
+def diagnosis_markdown(d: Mapping) -> str:
+    """A short plain-language diagnosis a test engineer can act on."""
+    lines = [f"# Discrepancy diagnosis: assembly {d['assembly']}", ""]
+    E0, E1 = d["metric_before"], d["metric_after"]
+    if d["effect"] in EFFECTS:
+        c = next(c for c in d["candidates"] if c["name"] == d["effect"])
+        vals = {k: v["value"] for k, v in c["effect_parameters"].items()}
+        lines += [f"**Missing effect: `{d['effect']}`** (confidence {d['confidence']}).", "",
+                  EFFECTS[d["effect"]].advice(vals)[0].upper() + EFFECTS[d["effect"]].advice(vals)[1:] + ".", "",
+                  f"With it the validation error E (1 = the measured repeat scatter) goes from {E0:.2f} to {E1:.2f} "
+                  f"({(E1 / E0 - 1) * 100:+.0f}%), checked with the time simulation driven by each run's measured "
+                  "base record.", ""]
+        if c["fingerprints_for"]:
+            lines += ["Evidence: " + "; ".join(c["fingerprints_for"]) + "."]
+    elif d["effect"] == "none":
+        lines += [f"**No missing effect**: the calibrated model predicts levels it did not see within "
+                  f"{d['baseline']['held_out_score']:.2f}x the measured repeat scatter (E = {E0:.2f}).", ""]
+    else:
+        lines += [f"**Unexplained**: the model misses the measurement (E = {E0:.2f}, held-out score "
+                  f"{d['baseline']['held_out_score']:.2f}) and no single library effect closes the gap decisively. "
+                  "Best candidates:", ""]
+        for c in d["candidates"][:3]:
+            lines.append(f"- `{c['name']}`: held-out score {c['held_out_score']:.2f}; against it: "
+                         + ("; ".join(c["fingerprints_against"][:2]) or "nothing"))
+        lines += ["", "Look for a second effect or one outside the library (e.g. a contact, a second mode)."]
+    lines += ["", "| model | held-out score |", "|---|---|", f"| baseline | {d['baseline']['held_out_score']:.2f} |"]
+    lines += [f"| {c['name']} | {c['held_out_score']:.2f} |" for c in d["candidates"]]
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,70 @@
+"""Figures of the discrepancy stage: residual maps, and envelopes before and after the named effect."""
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+import pandas as pd
+
+__all__ = ["residual_map_figure", "before_after_figure"]
+
+
+def residual_map_figure(res: pd.DataFrame, diagnosis: Mapping, path) -> None:
+    """Baseline residuals (measured over model, in repeat-scatter units) against f/f_res, per level and direction."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 1, figsize=(8, 6), sharex=True, constrained_layout=True)
+    levels = sorted(res["level"].unique())
+    cmap = plt.get_cmap("viridis", max(len(levels), 2))
+    for i, lev in enumerate(levels):
+        for d, ls in (("up", "-"), ("down", "--")):
+            g = res[(res["level"] == lev) & (res["direction"] == d)]
+            for _, r in g.groupby("run_id"):
+                r = r.sort_values("f_over_fres")
+                axes[0].plot(r["f_over_fres"], r["z_mag"], ls, color=cmap(i), lw=1, label=f"{lev:g} g {d}")
+                axes[1].plot(r["f_over_fres"], r["z_phase"], ls, color=cmap(i), lw=1)
+    for ax, what in zip(axes, ("magnitude", "phase")):
+        ax.axhspan(-1, 1, color="0.85", zorder=0)
+        ax.set_ylabel(f"{what} residual\n(repeat-scatter units)", fontsize=10)
+        ax.tick_params(labelsize=9)
+    h, lab = axes[0].get_legend_handles_labels()
+    uniq = dict(zip(lab, h))
+    axes[0].legend(uniq.values(), uniq.keys(), fontsize=8, ncol=4)
+    axes[1].set_xlabel("f / f_res (measured)", fontsize=10)
+    axes[0].set_title(f"{diagnosis['assembly']}: measured / baseline model; decision: {diagnosis['effect']} "
+                      f"({diagnosis['confidence']})", fontsize=11)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def before_after_figure(frames_before: Mapping[str, pd.DataFrame], frames_after: Mapping[str, pd.DataFrame],
+                        diagnosis: Mapping, path) -> None:
+    """Measured (solid), baseline (dashed) and corrected (dotted) response envelopes, one down sweep per level."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(8, 4.5), constrained_layout=True)
+    cmap = plt.get_cmap("viridis", max(len(frames_after), 2))
+    for i, rid in enumerate(sorted(frames_after)):
+        a = frames_after[rid]
+        if not len(a):
+            continue
+        a = a.sort_values("f_hz")
+        ax.semilogy(a["f_hz"], a["resp_meas_g"], "-", color=cmap(i), lw=1.2, label=rid)
+        ax.semilogy(a["f_hz"], a["resp_sim_g"], ":", color=cmap(i), lw=1.4)
+        b = frames_before.get(rid)
+        if b is not None and len(b):
+            b = b.sort_values("f_hz")
+            ax.semilogy(b["f_hz"], b["resp_sim_g"], "--", color=cmap(i), lw=1.0)
+    ax.set_xlabel("drive frequency (Hz)", fontsize=10)
+    ax.set_ylabel("response envelope (g)", fontsize=10)
+    ax.tick_params(labelsize=9)
+    ax.legend(fontsize=7, ncol=2)
+    ax.set_title(f"{diagnosis['assembly']}: measured (solid), calibrated model (dashed), with "
+                 f"{diagnosis['recalibrated']['model']} (dotted); E {diagnosis['metric_before']:.2f} -> "
+                 f"{diagnosis['metric_after']:.2f}", fontsize=10)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

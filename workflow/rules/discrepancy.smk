@@ -1,0 +1,46 @@
+# Stage discrepancy: which named effect the calibrated model misses, the model with it, the gap before
+# and after (jointcal.discrepancy). Include after validate.smk (uses VALIDATION, ASSEMBLY_RE).
+DISCREPANCY = RESULTS / "discrepancy"
+
+
+rule discrepancy_assembly:
+    input:
+        runs=RESULTS / "ingest" / "runs.csv",
+        modal=RESULTS / "modal" / "modal_properties.csv",
+        env=expand(RESULTS / "envelopes" / "{run_id}.csv", run_id=RUN_IDS),
+        best=RESULTS / "calibration" / "{assembly}" / "ga_best.json",
+        validation=VALIDATION / "{assembly}" / "summary.json",
+        records=assembly_records,
+    output:
+        diagnosis=DISCREPANCY / "{assembly}" / "diagnosis.json",
+        markdown=report(DISCREPANCY / "{assembly}" / "diagnosis.md", caption="../report/discrepancy_md.rst",
+                        category="5. Discrepancy", subcategory="{assembly}"),
+        residuals=DISCREPANCY / "{assembly}" / "residuals.csv",
+        metrics_after=DISCREPANCY / "{assembly}" / "metrics_after.csv",
+        residual_figure=report(RESULTS / "figures" / "discrepancy_residuals_{assembly}.png",
+                               caption="../report/discrepancy_residuals.rst", category="5. Discrepancy",
+                               subcategory="{assembly}"),
+        before_after_figure=report(RESULTS / "figures" / "discrepancy_before_after_{assembly}.png",
+                                   caption="../report/discrepancy_before_after.rst", category="5. Discrepancy",
+                                   subcategory="{assembly}"),
+    params:
+        code=source_hash("discrepancy.py"),
+        discrepancy=config.get("discrepancy", {}),
+        calibrate=config.get("calibrate", {}),
+        validate=config.get("validate", {}),
+        envelopes=config["envelopes"],
+        modal=config["modal"],
+    wildcard_constraints:
+        assembly=ASSEMBLY_RE,
+    threads: 2
+    benchmark:
+        RESULTS / "benchmarks" / "discrepancy_{assembly}.tsv"
+    log:
+        RESULTS / "logs" / "discrepancy" / "{assembly}.log",
+    script:
+        "../scripts/discrepancy.py"
+
+
+rule discrepancy:
+    input:
+        expand(DISCREPANCY / "{assembly}" / "diagnosis.json", assembly=ASSEMBLIES),
