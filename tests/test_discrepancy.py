@@ -18,6 +18,7 @@ from jointcal.calibrate.space import PARAMS
 from jointcal.discrepancy import EFFECTS, DiscrepancySettings, decide, diagnose, score_candidates
 from jointcal.discrepancy.data import RunEnvelope
 from jointcal.discrepancy.fit import candidate, envelope_E, model_at, predict
+from jointcal.discrepancy.stage import valley_starts
 from jointcal.models import G
 
 M = 2.65 / G
@@ -128,10 +129,19 @@ def test_end_to_end_hidden_gain_is_named_and_the_gap_shrinks(tmp_path):
     cal, _ = run_calibration(tmp_path / "modal.csv", "a", tmp_path / "cal", CalibrateSettings())
     best = json.loads((tmp_path / "cal" / "ga_best.json").read_text())
     s = DiscrepancySettings(candidates=("sensor_gain", "channel_delay", "fixture_flexibility"))
-    out = diagnose("a", envs, table, best, None, records, rows, space=SPACE, settings=s, log=print)
+    starts = valley_starts(pd.read_csv(tmp_path / "cal" / "ga_history.csv"), best)
+    out = diagnose("a", envs, table, best, None, records, rows, space=SPACE, settings=s, joint_starts=starts,
+                   log=print)
     d = out["diagnosis"]
-    print(f"\n{d['effect']} ({d['confidence']}): E {d['metric_before']:.2f} -> {d['metric_after']:.2f}")
+    after = d["recalibrated"]["joint_parameters"]
+    err = {p: (abs(np.log(best[p] / t)), abs(np.log(after[p]["value"] / t))) for p, t in zip(PARAMS, TRUTH)
+           if p != "beta"}
+    print(f"\n{d['effect']} ({d['confidence']}): E {d['metric_before']:.2f} -> {d['metric_after']:.2f}; "
+          "|log error| of the joint parameters, calibration -> recalibrated: "
+          + ", ".join(f"{p} {a:.3f} -> {b:.3f}" for p, (a, b) in err.items()))
     assert d["effect"] == "sensor_gain"
     gain = d["recalibrated"]["effect_parameters"]["gain"]["value"]
     assert abs(gain / 1.12 - 1) < 0.01
     assert d["metric_after"] <= 0.3 * d["metric_before"]
+    before, after = (np.mean([e[i] for e in err.values()]) for i in (0, 1))
+    assert after < 0.5 * before  # the recalibrated joint moves toward the truth

@@ -9,6 +9,7 @@ rule discrepancy_assembly:
         modal=RESULTS / "modal" / "modal_properties.csv",
         env=expand(RESULTS / "envelopes" / "{run_id}.csv", run_id=RUN_IDS),
         best=RESULTS / "calibration" / "{assembly}" / "ga_best.json",
+        history=RESULTS / "calibration" / "{assembly}" / "ga_history.csv",
         validation=VALIDATION / "{assembly}" / "summary.json",
         records=assembly_records,
     output:

@@ -14,6 +14,7 @@ import pandas as pd
 
 from jointcal.calibrate import CalibrateSettings
 from jointcal.discrepancy import DiscrepancySettings, diagnose, diagnosis_markdown
+from jointcal.discrepancy.stage import valley_starts
 from jointcal.io import listed_record, read_run, write_bytes_atomic, write_csv_atomic, write_json_atomic
 from jointcal.report.discrepancy import before_after_figure, residual_map_figure
 from jointcal.validate import ValidateSettings
@@ -41,12 +42,13 @@ def main(smk) -> None:
         best = json.loads(Path(smk.input.best).read_text())
         summary = json.loads(Path(smk.input.validation).read_text())
         space = CalibrateSettings.from_config(smk.params.calibrate).space
+        starts = valley_starts(pd.read_csv(smk.input.history), best)
         n = max(1, int(smk.threads))
         with ProcessPoolExecutor(max_workers=n) as ex:
             out = diagnose(asm, envs, modal, best, summary.get("scale"), records, rows, space=space,
                            settings=settings, validate_settings=ValidateSettings.from_config(smk.params.validate),
                            envelopes_kw=dict(smk.params.envelopes), modal_kw=dict(smk.params.modal),
-                           metric_before=float(summary["E"]), executor=ex if n > 1 else None, log=say)
+                           metric_before=float(summary["E"]), joint_starts=starts, executor=ex if n > 1 else None, log=say)
     except (ValueError, KeyError) as exc:
         say(f"{asm}: {exc}")
         sys.exit(f"jointcal: {asm}: {exc}")

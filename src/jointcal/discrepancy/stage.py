@@ -25,11 +25,11 @@ from ..models import harmonic_balance
 from ..validate import ValidateSettings, model_from_best, validate_runs
 from .data import run_envelope, scale_arrays
 from .fingerprints import fingerprints, residual_map, verdicts
-from .fit import candidate, model_at
+from .fit import candidate, fit_candidate, model_at
 from .library import EFFECTS
 from .select import CLOSE_FRACTION, MARGIN, NONE_E, decide, score_candidates
 
-__all__ = ["DiscrepancySettings", "diagnose"]
+__all__ = ["DiscrepancySettings", "diagnose", "diagnosis_markdown", "valley_starts"]
 
 
 @dataclass(frozen=True)
@@ -65,6 +65,20 @@ class DiscrepancySettings:
         return cls(**section)
 
 
+def valley_starts(history: pd.DataFrame, best: Mapping, *, n: int = 3, rel: float = np.inf) -> list[list[float]]:
+    """The GA's best individual in each half-decade of Fs other than the optimum's (within `rel` x the
+    best objective), the n best of them: joint starts (Fs, KT, chi, beta, k, zeta_v) from other valleys.
+    A missing effect biases eq. 3.9 itself, so a valley it ranks far worse may fit the envelopes best."""
+    h = history.dropna(subset=list(PARAMS) + ["objective"])
+    h = h[h["objective"] <= rel * h["objective"].min()]
+    if h.empty:
+        return []
+    bins = np.floor(2 * np.log10(h["Fs"].to_numpy()))
+    own = np.floor(2 * np.log10(float(best["Fs"])))
+    picks = h.assign(bin=bins)[bins != own].sort_values("objective").groupby("bin").head(1)
+    return picks.sort_values("objective")[list(PARAMS)].head(n).to_numpy().tolist()
+
+
 def _interval(fit, c, i) -> list[float]:
     """Approximate 90% interval of parameter i (physical units) from the unit-cube covariance."""
     sd = np.sqrt(max(fit.cov_unit[i, i], 0.0))
@@ -80,7 +94,7 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
              space: ParamSpace, settings: DiscrepancySettings = DiscrepancySettings(),
              validate_settings: ValidateSettings = ValidateSettings(), envelopes_kw: dict | None = None,
              modal_kw: dict | None = None, metric_before: float | None = None, executor=None,
-             log: Callable[[str], None] | None = None) -> dict:
+             joint_starts: Sequence[Sequence[float]] = (), log: Callable[[str], None] | None = None) -> dict:
     """Diagnose one assembly; returns the diagnosis (diagnosis.json's content plus tables and models).
 
     Parameters
@@ -89,7 +103,9 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     best : the calibration's ga_best.json; scale : the validation's repeat-scatter bins
     (summary.json's "scale"); records, rows : measured records and manifest rows of the
     assembly's runs (for the time-simulation revalidation); metric_before : the validation
-    stage's E (recomputed when None).
+    stage's E (recomputed when None); joint_starts : further joint parameter sets (6,) from
+    which the final model is also refit (e.g. the GA's best individual in each other valley:
+    eq. 3.9 leaves the Fs-KT split flat, the envelopes may not).
     """
     say = log or (lambda s: None)
     t_start = time.perf_counter()
@@ -141,6 +157,12 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     named = next((s for s in ranked if s.name == effect), None)
     final = named if named is not None else base
     cf = candidate(final.name, space, m)
+    for th in joint_starts:  # the final model from the GA's other valleys too
+        start = np.r_[np.asarray(th, dtype=float)[:6], final.fit.theta[6:]]
+        alt = fit_candidate(cf, runs, start, starts=1, max_nfev=2 * settings.max_nfev)
+        say(f"{assembly}: {final.name} refit from Fs = {th[0]:.3g} lbf: E {alt.E:.2f} (kept: {final.fit.E:.2f})")
+        if alt.E < final.fit.E:
+            final = type(final)(final.name, alt, final.score, final.held_out, final.seconds)
     models_after = {r["run_id"]: model_at(cf, final.fit.theta, r) for r in rows}
     say(f"{assembly}: decision {effect} ({confidence}); revalidating with the time simulation")
     v_after = validate_runs([models_after[r["run_id"]] for r in rows], records, rows, settings=validate_settings,
@@ -162,9 +184,10 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
         "candidates": cand_out, "fingerprints": fp,
         "metric_before": float(metric_before), "metric_after": metric_after,
         "metric_change": metric_after / metric_before - 1.0 if metric_before else None,
-        "recalibrated": {"model": final.name, "joint_parameters": joint_after,
-                         "effect_parameters": (cand_out[ranked.index(named)]["effect_parameters"]
-                                               if named is not None else {})},
+        "recalibrated": {"model": final.name, "joint_parameters": joint_after, "E_fit": final.fit.E,
+                         "effect_parameters": {p.name: {"value": float(final.fit.theta[6 + i]), "unit": p.unit,
+                                                        "interval_90": _interval(final.fit, cf, 6 + i)}
+                                               for i, p in enumerate(cf.effect_params)}},
         "calibration_joint_parameters": dict(zip(PARAMS, map(float, theta0))),
         "words_after": v_after.words, "seconds": time.perf_counter() - t_start,
     }
