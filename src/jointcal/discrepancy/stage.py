@@ -207,7 +207,14 @@ def diagnosis_markdown(d: Mapping) -> str:
                   f"({(E1 / E0 - 1) * 100:+.0f}%), checked with the time simulation driven by each run's measured "
                   "base record.", ""]
         if c["fingerprints_for"]:
-            lines += ["Evidence: " + "; ".join(c["fingerprints_for"]) + "."]
+            lines += ["Evidence: " + "; ".join(c["fingerprints_for"]) + ".", ""]
+        ep = d["recalibrated"]["effect_parameters"]
+        bounds = {p.name: (p.lo, p.hi) for p in EFFECTS[d["effect"]].params}
+        for k, v in ep.items():
+            lo, hi = v["interval_90"]
+            loose = lo <= bounds[k][0] * (1 + 1e-6) or hi >= bounds[k][1] * (1 - 1e-6)
+            lines.append(f"- {k} = {v['value']:.4g} {v['unit']}, 90% interval [{lo:.4g}, {hi:.4g}]"
+                         + (" (reaches a bound of the library's range: the data do not pin it)" if loose else ""))
     elif d["effect"] == "none":
         lines += [f"**No missing effect**: the calibrated model predicts levels it did not see within "
                   f"{d['baseline']['held_out_score']:.2f}x the measured repeat scatter (E = {E0:.2f}).", ""]
