@@ -34,3 +34,14 @@ ASSEMBLIES = list(dict.fromkeys(r["assembly"] for r in _manifest_rows() if r.get
 def run_record(wildcards):
     """The raw record of one run."""
     return RUN_FILES[wildcards.run_id]
+
+
+def ingest_table(wildcards):
+    """The ingest stage's runs.csv when the workflow has that stage (one of calibrate + posterior only has not)."""
+    from snakemake.exceptions import WorkflowError
+
+    try:
+        rules.ingest
+    except (WorkflowError, AttributeError):
+        return []
+    return [str(RESULTS / "ingest" / "runs.csv")]
