@@ -60,6 +60,17 @@ def run_record(wildcards):
     return RUN_FILES[wildcards.run_id]
 
 
+def ingest_table(wildcards):
+    """The ingest stage's runs.csv when the workflow has that stage (one of calibrate + posterior only has not)."""
+    from snakemake.exceptions import WorkflowError
+
+    try:
+        rules.ingest
+    except (WorkflowError, AttributeError):
+        return []
+    return [str(RESULTS / "ingest" / "runs.csv")]
+
+
 def assembly_records(wildcards):
     """The raw records of one assembly's runs."""
     return [str(RAW_DATA / r["file"]) for r in _manifest_rows() if r.get("assembly") == wildcards.assembly]

@@ -84,8 +84,7 @@ rule posterior_report:
 
 rule report_summary:
     input:
-        # the ingest table when the workflow has that stage (a Snakefile of calibrate + posterior only has not)
-        runs=lambda wc: [str(RESULTS / "ingest" / "runs.csv")] if hasattr(rules, "ingest") else [],
+        runs=ingest_table,
         modal=RESULTS / "modal" / "modal_properties.csv",
         table=POSTERIOR / "table_3_2.csv",
         history=expand(RESULTS / "calibration" / "{assembly}" / "ga_history.csv", assembly=ASSEMBLIES),

@@ -26,11 +26,11 @@ from .summary import fmt
 __all__ = ["amplitude_figure", "exploration_figure", "convergence_figure", "corner_figure"]
 
 
-def _figure(width: float, height: float):
+def _figure(width: float, height: float, dpi: float = 110):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(width, height), dpi=110)
+    fig = Figure(figsize=(width, height), dpi=dpi)
     FigureCanvasAgg(fig)
     return fig
 
@@ -135,7 +135,7 @@ def exploration_figure(history: pd.DataFrame, *, title: str = "", max_points: in
               if v is not None}
     lim = {c: _axis_values(c, np.asarray(bounds[c], dtype=float)) for c in PARAMS if bounds and c in bounds}
     n = len(cols)
-    fig = _figure(1.9 * n + 1.2, 1.9 * n)
+    fig = _figure(1.35 * n + 2.2, 1.35 * n, dpi=88)  # <= ~850 px tall: Snakemake's report clips taller images
     axes = fig.subplots(n, n)
     sc = None
     for i, ci in enumerate(cols):
@@ -172,12 +172,12 @@ def exploration_figure(history: pd.DataFrame, *, title: str = "", max_points: in
         handles, labels = axes[1, 0].get_legend_handles_labels()
         text = [f"{lab}: objective {fmt(v['objective'])}" if "objective" in v else lab
                 for lab, (v, _) in points.items()]
-        fig.legend(handles, text, loc="upper right", bbox_to_anchor=(0.99, 0.52), fontsize=9, frameon=False)
+        fig.legend(handles, text, loc="upper right", bbox_to_anchor=(0.995, 0.52), fontsize=9, frameon=False)
     fig.suptitle(f"GA exploration {title} (colour: log10 objective, dark = low; axes span the search bounds)".strip(),
                  fontsize=11)
     fig.tight_layout(rect=(0, 0, 0.88, 0.97))
     if sc is not None:  # after tight_layout, which does not handle a free-standing axes
-        cax = fig.add_axes((0.90, 0.55, 0.018, 0.35))
+        cax = fig.add_axes((0.89, 0.57, 0.02, 0.35))
         cb = fig.colorbar(sc, cax=cax)
         cb.set_label("log10 objective (eq. 3.9)", fontsize=9)
         cb.ax.tick_params(labelsize=8)
@@ -235,7 +235,7 @@ def corner_figure(samples: NDArray[np.float64], names: Sequence[str], *, truth: 
     """
     samples = np.asarray(samples, dtype=float)
     d = samples.shape[1]
-    fig = _figure(1.7 * d, 1.7 * d)
+    fig = _figure(1.2 * d + 0.4, 1.2 * d, dpi=88)  # <= ~850 px tall: Snakemake's report clips taller images
     axes = fig.subplots(d, d)
     lims = [np.percentile(samples[:, i], [0.5, 99.5]) for i in range(d)]
     lims = [(a, b) if b > a else (a - 0.5, a + 0.5) for a, b in lims]
@@ -312,7 +312,7 @@ def corner_figure(samples: NDArray[np.float64], names: Sequence[str], *, truth: 
                               mfc="none" if st.get("open") else st["color"], label=k))
     if bounds is not None:
         handles.append(Line2D([], [], color="0.4", ls="--", label="prior bound"))
-    fig.legend(handles=handles, loc="upper right", bbox_to_anchor=(0.98, 0.80), fontsize=10, frameon=False)
+    fig.legend(handles=handles, loc="upper right", bbox_to_anchor=(0.99, 0.82), fontsize=9, frameon=False)
     lines = []
     if stamp is not None:
         lines.append((stamp[0], "darkgreen" if stamp[1] else "#b00000"))
@@ -326,7 +326,7 @@ def corner_figure(samples: NDArray[np.float64], names: Sequence[str], *, truth: 
         if at:
             lines.append(("at a prior bound: " + ", ".join(at), "#b36b00"))
     for k, (text, colour) in enumerate(lines):
-        fig.text(0.98, 0.97 - 0.035 * k, text, ha="right", va="top", fontsize=12, color=colour, weight="bold")
+        fig.text(0.99, 0.975 - 0.035 * k, text, ha="right", va="top", fontsize=11, color=colour, weight="bold")
     if title:
         fig.suptitle(title, fontsize=12, x=0.02, ha="left")
     fig.tight_layout(rect=(0, 0, 1, 0.97))
