@@ -42,6 +42,26 @@ rule discrepancy_assembly:
         "../scripts/discrepancy.py"
 
 
+rule discrepancy_table:
+    input:
+        best=expand(RESULTS / "calibration" / "{assembly}" / "ga_best.json", assembly=ASSEMBLIES),
+        diagnosis=expand(DISCREPANCY / "{assembly}" / "diagnosis.json", assembly=ASSEMBLIES),
+    output:
+        table=report(DISCREPANCY / "table_3_2_corrected.html", caption="../report/table_3_2_corrected.rst",
+                     category="5. Discrepancy"),
+    params:
+        code=source_hash("discrepancy_table.py"),
+        assemblies=ASSEMBLIES,
+    threads: 1
+    benchmark:
+        RESULTS / "benchmarks" / "discrepancy_table.tsv"
+    log:
+        RESULTS / "logs" / "discrepancy_table.log",
+    script:
+        "../scripts/discrepancy_table.py"
+
+
 rule discrepancy:
     input:
         expand(DISCREPANCY / "{assembly}" / "diagnosis.json", assembly=ASSEMBLIES),
+        rules.discrepancy_table.output,

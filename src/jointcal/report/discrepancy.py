@@ -68,3 +68,29 @@ def before_after_figure(frames_before: Mapping[str, pd.DataFrame], frames_after:
                  f"{diagnosis['metric_after']:.2f}", fontsize=10)
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def table_3_2_corrected_html(best: Mapping[str, Mapping], diagnoses: Mapping[str, Mapping]) -> str:
+    """Table 3.2 with the paper's model (the calibration's optimum on eq. 3.9) and the corrected one.
+
+    best : assembly -> ga_best.json; diagnoses : assembly -> diagnosis.json.
+    """
+    from ..calibrate.space import PARAMS, UNITS
+
+    head = "".join(f"<th>{p} ({UNITS[p]})</th>" for p in PARAMS)
+    rows = []
+    for a, d in diagnoses.items():
+        b = best[a]
+        rec = d["recalibrated"]
+        eff = ", ".join(f"{k} = {v['value']:.4g} {v['unit']}" for k, v in rec["effect_parameters"].items()) or "-"
+        rows.append(f"<tr><td>{a}</td><td>paper's model (eq. 3.9 optimum)</td>"
+                    + "".join(f"<td>{b[p]:.4g}</td>" for p in PARAMS) + f"<td>-</td><td>{d['metric_before']:.2f}</td></tr>")
+        rows.append(f"<tr><td>{a}</td><td>corrected: {rec['model']} ({d['effect']}, {d['confidence']})</td>"
+                    + "".join(f"<td>{rec['joint_parameters'][p]['value']:.4g}</td>" for p in PARAMS)
+                    + f"<td>{eff}</td><td>{d['metric_after']:.2f}</td></tr>")
+    return ("<html><head><meta charset='utf-8'><style>td,th{padding:3px 8px;border-bottom:1px solid #ccc;"
+            "font-family:sans-serif;font-size:13px}</style></head><body>"
+            "<h3>Table 3.2: the paper's model and the corrected one</h3><table><tr><th>assembly</th><th>model</th>"
+            + head + "<th>effect</th><th>validation E</th></tr>" + "".join(rows) + "</table>"
+            "<p>E: validation envelope error, time simulation driven by the measured base records "
+            "(1 = the measured repeat scatter).</p></body></html>")
