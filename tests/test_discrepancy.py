@@ -89,6 +89,15 @@ def test_the_sweep_lag_is_not_mistaken_for_a_delay():
     assert name == "none"
 
 
+def test_the_virtual_lab_hides_two_effects_at_once():
+    from jointcal.synth.campaign import _model
+
+    truth = dict(zip(PARAMS, TRUTH), m=M)
+    one = _model(truth, 4, "joint_settling", {"Fs_drift": 0.1, "KT_drift": 0.05, "n_settle": 3.0},
+                 {"name": "sensor_gain", "params": {"gain": 1.1}})
+    assert one.sensor_gain == 1.1 and one.iwan.Fs > TRUTH[0] * 1.05  # both present, neither undone
+
+
 def test_bad_settings_are_one_sentence():
     with pytest.raises(ValueError, match="unknown effect"):
         DiscrepancySettings(candidates=("sensor_gain", "gremlins"))

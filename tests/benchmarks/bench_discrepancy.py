@@ -40,6 +40,9 @@ CASES = [
     ("fixture_flexibility", {"f_can_hz": 3000.0}), ("fixture_flexibility", {"f_can_hz": 8000.0}),
     ("joint_settling", {"Fs_drift": 0.05, "KT_drift": 0.05}), ("joint_settling", {"Fs_drift": 0.15, "KT_drift": 0.1}),
     ("cubic_stiffening", {"k3": 2e11}), ("quadratic_damping", {"c2": 0.4}),
+    # two effects at once: a name among the two is right, a third name or high confidence on one is not
+    ("sensor_gain", {"gain": 1.1, "also": {"name": "channel_delay", "params": {"tau_s": 4e-5}}}),
+    ("fixture_flexibility", {"f_can_hz": 6000.0, "also": {"name": "quadratic_damping", "params": {"c2": 0.4}}}),
 ]
 
 
@@ -50,7 +53,9 @@ def run_case(i, name, params, tmp: Path):
             "series": [{"level_g": 1.0, "directions": ["up", "down"], "repeats": 2},
                        {"level_g": 3.0, "directions": ["up", "down"], "repeats": 1},
                        {"level_g": 10.0, "directions": ["up", "down"], "repeats": 1}],
-            "assemblies": {"a": joint}, "effect": {"name": name, "params": params}}
+            "assemblies": {"a": joint},
+            "effect": {"name": name, "params": {k: v for k, v in params.items() if k != "also"},
+                       **({"also": params["also"]} if "also" in params else {})}}
     generate(spec, tmp / "c", tmp / "truth.json")
     man = read_manifest(tmp / "c" / "manifest.csv")
     rows, envs, records, props = [], {}, [], []

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from dataclasses import replace
+from dataclasses import fields, replace
 
 from ..io import write_csv_atomic, write_json_atomic, write_run
 from ..models import G, resonance_amplitude, simulate
@@ -80,11 +80,19 @@ def _truth_row(truth: dict, model, level: float) -> dict:
 _PLACEHOLDER_JOINT = {"Fs": 1.0, "KT": 1.0, "chi": -0.5, "beta": 0.1}
 
 
-def _model(truth: dict, sequence: int, effect: str, eparams: dict):
-    """The run's model: `run_model`, or its linear version for an assembly without a joint."""
-    if all(k in truth for k in JOINT_KEYS):
-        return run_model(truth, sequence, effect, eparams)
-    return replace(run_model({**truth, **_PLACEHOLDER_JOINT}, sequence, effect, eparams), iwan=None)
+def _model(truth: dict, sequence: int, effect: str, eparams: dict, also: dict | None = None):
+    """The run's model: `run_model`, or its linear version for an assembly without a joint; with
+    `also` ({name, params}) the second effect's fields are laid over the first's."""
+    joint = all(k in truth for k in JOINT_KEYS)
+    t = truth if joint else {**truth, **_PLACEHOLDER_JOINT}
+    model = run_model(t, sequence, effect, eparams)
+    if also:
+        plain = run_model(t, sequence, "none", {})
+        second = run_model(t, sequence, also["name"], effect_defaults(also["name"], also.get("params")))
+        changed = {f.name: getattr(second, f.name) for f in fields(second)
+                   if getattr(second, f.name) != getattr(plain, f.name)}
+        model = replace(model, **changed)
+    return model if joint else replace(model, iwan=None)
 
 
 def generate(spec: dict | str | os.PathLike, out_dir: str | os.PathLike, truth_path: str | os.PathLike) -> pd.DataFrame:
@@ -122,7 +130,7 @@ def generate(spec: dict | str | os.PathLike, out_dir: str | os.PathLike, truth_p
         run_rng = np.random.default_rng([spec["seed"], int(rng.integers(2**31))])
         truth = {k: v for k, v in spec["assemblies"][row.assembly].items() if k != "weight_lbf"}
         truth["m"] = masses[row.assembly]
-        model = _model(truth, row.sequence, effect, eparams)
+        model = _model(truth, row.sequence, effect, eparams, spec["effect"].get("also"))
         level = row.level_g if ref == "base" else row.level_V
         # base: the controller holds the base acceleration (ripple); a rig's amplifier is open loop
         t, f_inst, drive = daq.controlled_sweep(fs_sim, row.f_start_hz, row.f_stop_hz, row.sweep_rate_hz_per_s,

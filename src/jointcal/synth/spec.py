@@ -28,7 +28,8 @@ measurement          noise_fraction (of each channel's RMS), dc_offset_g (std), 
                      rate / output rate), antialias_order, antialias_cutoff (x output
                      rate), ripple (controller amplitude ripple), distortion [2nd, 3rd].
 effect               {name, params} or effect_file (YAML/JSON holding {name, params},
-                     relative to the spec): the hidden effect, 'none' by default.
+                     relative to the spec): the hidden effect, 'none' by default; an
+                     optional ``also: {name, params}`` hides a second one at the same time.
 """
 from __future__ import annotations
 
@@ -184,7 +185,13 @@ def load_spec(spec: dict | str | os.PathLike) -> dict:
             raise ValueError(f"{where}: effect_file {ef} not found; fix the path (relative to the spec).")
         s["effect"] = _parse(ef)
     _check_shapes(s, where)
+    also = s["effect"].get("also")  # a second hidden effect at the same time: {name, params}
     s["effect"] = {"name": s["effect"].get("name", "none"), "params": s["effect"].get("params") or {}}
+    if also:
+        if not isinstance(also, dict) or "name" not in also:
+            raise ValueError(f"{where}: effect.also must be a mapping {{name, params}} naming a second effect.")
+        s["effect"]["also"] = {"name": also["name"], "params": also.get("params") or {}}
+        effect_defaults(also["name"], s["effect"]["also"]["params"])
     _coerce(s, where)
     effect_defaults(s["effect"]["name"], s["effect"]["params"])
     if s["file_format"] not in ("csv", "csv.gz", "mat"):
