@@ -97,7 +97,7 @@ def _away_from_fold(model, ss, f, level):
     equivalent linear system frozen at its amplitude: d ln q / d ln f stays finite away from a fold
     and diverges at one, where a sweep's transient lags furthest behind the steady state."""
     mu, gamma = _structure_terms(model, 2 * np.pi * f, (1, f.size))
-    mu, gamma = mu[0], gamma[0]
+    mu, gamma = mu[0], (np.ones(f.size) if gamma is None else gamma[0])
     Kz = -gamma * M * level * G / ss.relative + mu  # the joint DOF's dynamic stiffness at the solution
     frozen = np.zeros(f.size)
     i = np.arange(1, f.size - 1)

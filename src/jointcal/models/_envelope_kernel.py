@@ -143,6 +143,8 @@ def _root(s0, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, k3, c2, n
     for _ in range(200):
         b = a + direction * step
         rb, db, re, im = _residual(b, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights)
+        if abs(rb) < tol and not jumped:  # the Newton step from a continued guess has converged
+            return b, False, re, im
         if rb * ra <= 0.0:
             break
         if abs(rb) > abs(rprev):  # moving away from zero: r turned at an extremum, the branch is gone

@@ -85,7 +85,7 @@ def _structure_terms(model: MinistackModel, w: NDArray, shape) -> tuple[NDArray,
     """
     m = _field(model.m, shape)[:, None]
     if model.fixture is None:
-        return m * w**2 + 0j, np.ones((m.shape[0], w.size), complex)
+        return m * w**2, None  # real inertia, unit load factor
     fx = model.fixture
     m_can = _field(fx.m_can, shape)[:, None]
     k_can = m_can * (2 * np.pi * _field(fx.f_can, shape)[:, None]) ** 2
@@ -158,23 +158,27 @@ def steady_state(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike = 1.0
         J1 = _J(chi, np.ones_like(chi))
     c = 2.0 * zv * np.sqrt((k + KT) * m)
     mu, gamma = _structure_terms(model, w, shape)
-    logB = np.log(np.abs(gamma) * m[:, None] * A)
+    rigid = model.fixture is None  # gamma = 1, mu real: skip the complex work
+    logB = np.log(m[:, None] * A) + (0.0 if rigid else np.log(np.abs(gamma)))
     order = np.argsort(f, kind="stable")
     if direction == "down":
         order = order[::-1]
     n0 = order[0]
     stuck = k + KT + 1j * w[n0] * c
-    s0 = np.log(np.abs(gamma[:, n0]) * m * A[n0] / np.abs(stuck - mu[:, n0]))
+    g0 = 1.0 if rigid else np.abs(gamma[:, n0])
+    s0 = np.log(g0 * m * A[n0] / np.abs(stuck - mu[:, n0]))
     s = np.empty((P, f.size))
     jump = np.zeros((P, f.size), dtype=np.bool_)
     kre, kim = np.empty((P, f.size)), np.empty((P, f.size))
     solver = _k.solve_parallel if P >= 64 else _k.solve  # threads pay off only for large batches
-    solver(w, np.ascontiguousarray(mu.real), np.ascontiguousarray(mu.imag), np.ascontiguousarray(logB), s0,
+    mu_re = np.ascontiguousarray(mu.real)
+    mu_im = np.zeros_like(mu_re) if rigid else np.ascontiguousarray(mu.imag)
+    solver(w, mu_re, mu_im, np.ascontiguousarray(np.broadcast_to(logB, (P, f.size))), s0,
              order.astype(np.int64), k, c, KT, R, chi, phimax, S, J1, k3, c2, _NODES, _WEIGHTS, TOL, s, jump,
              kre, kim)
     q = np.exp(s)
     Kz = kre + 1j * kim
-    Z = -gamma * m[:, None] * A / (Kz - mu)
+    Z = -(m[:, None] * A) / (Kz - mu_re) if rigid else -gamma * m[:, None] * A / (Kz - mu)
     # absolute slug acceleration: a_b - omega^2 (W + Z); the can's motion W from its row
     if model.fixture is None:
         W = 0.0
@@ -188,6 +192,9 @@ def steady_state(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike = 1.0
     T = 1.0 - w**2 * (W + Z) / A
     gain = _field(model.sensor_gain, shape)[:, None]
     tau = _field(model.sensor_delay_s, shape)[:, None]
-    T = gain * T * np.exp(-1j * w * tau)
+    if np.any(gain != 1.0):
+        T = gain * T
+    if np.any(tau != 0.0):
+        T = T * np.exp(-1j * w * tau)
     return SteadyState(T.reshape(out_shape), Z.reshape(out_shape), q.reshape(out_shape), jump.reshape(out_shape))
 
