@@ -26,7 +26,8 @@ from jointcal.posterior import PosteriorSettings, run_posterior
 SCRIPTS = REPO / "workflow" / "scripts"
 SCHEMA = REPO / "workflow" / "schemas" / "config.schema.yaml"
 DOWNSTREAM_OF_MODAL = {"modal_properties", "modal_figures", "calibrate_assembly", "calibration_figures",
-                       "posterior_assembly", "posterior_corner", "posterior_report"}
+                       "posterior_assembly", "posterior_corner", "posterior_report", "report_summary",
+                       "validate_assembly", "validate_figures", "discrepancy_assembly", "discrepancy_table"}
 
 
 def _names(files: list[Path]) -> set[str]:
@@ -133,6 +134,9 @@ def touched(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[str]]:
     assert summary.returncode == 0, summary.stderr
     for line in summary.stdout.splitlines()[1:]:
         out = Path(line.split("\t")[0])
+        if not out.suffix:  # a directory() output (modal/frf, validation/<assembly>/envelopes)
+            out.mkdir(parents=True, exist_ok=True)
+            continue
         out.parent.mkdir(parents=True, exist_ok=True)
         out.touch()
     res = _snakemake(work, "--cores", "1", "--touch", "--forceall", *cfg)
@@ -153,7 +157,8 @@ def test_editing_a_stage_module_reruns_that_stage_and_its_descendants_only(touch
     pkg = work / "src" / "jointcal"
     cases = [
         ("modal.py", DOWNSTREAM_OF_MODAL),  # not ingest, not envelopes
-        ("report/calibration.py", {"calibration_figures", "posterior_corner", "posterior_report"}),  # figures only
+        ("report/calibration.py", {"calibration_figures", "posterior_corner", "posterior_report", "report_summary",
+                                    "validate_figures"}),  # figures and report pages only
     ]
     for module, expected in cases:
         original = _edit(pkg / module)
@@ -173,7 +178,9 @@ def test_typo_in_config_is_one_line_before_any_schema_dump(touched):
         "'calibrate.population'? (all settings: workflow/config/config.yaml)")
     assert "Failed validating" not in res.stderr and "Traceback" not in res.stderr
     assert _jobs(_snakemake(work, "-n", *cfg, "posterior={ball: 0.002}")) == {
-        "posterior_assembly": 1, "posterior_corner": 1, "posterior_report": 1, "all": 1}  # params changed
+        "posterior_assembly": 1, "posterior_corner": 1, "posterior_report": 1, "report_summary": 1,
+        "validate_assembly": 1, "validate_figures": 1, "discrepancy_assembly": 1, "discrepancy_table": 1,
+        "all": 1}  # params changed: the posterior and what uses its chain
 
 
 @pytest.mark.slow
@@ -189,7 +196,9 @@ def test_slurm_profile_dry_run_has_one_job_per_run_and_per_assembly(tmp_path):
     assert "workflow/profiles/slurm" in res.stderr + res.stdout
     assert _jobs(res) == {"ingest": 1, "envelopes_run": 24, "modal_properties": 1, "modal_figures": 1,
                           "calibrate_assembly": 2, "calibration_figures": 2, "posterior_assembly": 2,
-                          "posterior_corner": 2, "posterior_report": 1, "all": 1}
+                          "posterior_corner": 2, "posterior_report": 1, "report_summary": 1,
+                          "validate_assembly": 2, "validate_figures": 1, "discrepancy_assembly": 2,
+                          "discrepancy_table": 1, "all": 1}
     blocks = re.findall(r"rule (\w+):\n(?:    .*\n)*?    resources: (.*)", res.stdout + res.stderr)
     resources = {rule: dict(kv.split("=", 1) for kv in line.split(", ")) for rule, line in blocks}
     assert resources["calibrate_assembly"]["runtime"] == "30" and resources["posterior_assembly"]["runtime"] == "60"

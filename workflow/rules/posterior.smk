@@ -96,11 +96,14 @@ rule report_summary:
         table=report(POSTERIOR / "table_3_2.html", caption="../report/table_3_2.rst", category="3. Posterior"),
         landing=RESULTS / "report" / "landing.html",
     params:
+        code=source_hash("report_summary.py"),
         calibrate=config.get("calibrate", {}),
         posterior=config.get("posterior", {}),
         assemblies=ASSEMBLIES,
         campaign=str(RAW_DATA),
     threads: 1
+    benchmark:
+        RESULTS / "benchmarks" / "report_summary.tsv"
     log:
         RESULTS / "logs" / "report_summary.log",
     script:
