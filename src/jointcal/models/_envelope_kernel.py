@@ -240,3 +240,17 @@ def solve_parallel(w, mu_re, mu_im, logB, s_start, order, kp, c, KT, R, chi, phi
             jump_out[p, n] = jumped and jj > 0
             kre_out[p, n] = re
             kim_out[p, n] = im
+
+
+@njit(cache=True)
+def rigid_output(kre, kim, mu, mA, w, A, gain, tau, Z_out, T_out):
+    """Rigid base, in one pass: Z = -m A / (K_z - m omega^2), T = gain (1 - omega^2 Z / A) e^{-i omega tau}."""
+    P, N = kre.shape
+    for p in range(P):
+        for n in range(N):
+            z = -mA[p, n] / complex(kre[p, n] - mu[p, n], kim[p, n])
+            Z_out[p, n] = z
+            t = gain[p] * (1.0 - w[n] * w[n] * z / A[n])
+            if tau[p] != 0.0:
+                t *= np.exp(complex(0.0, -w[n] * tau[p]))
+            T_out[p, n] = t
