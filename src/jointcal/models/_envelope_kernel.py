@@ -176,8 +176,7 @@ def _root(s0, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, k3, c2, n
     return s, jumped, re, im
 
 
-@njit(cache=True)
-def solve(w, mu_re, mu_im, logB, s_start, order, kp, c, KT, R, chi, phimax, S, J1, k3, c2,
+def _solve(w, mu_re, mu_im, logB, s_start, order, kp, c, KT, R, chi, phimax, S, J1, k3, c2,
           nodes, weights, tol, s_out, jump_out, kre_out, kim_out):
     """Amplitudes s = log q (P, N) by continuation along `order` for every parameter set.
 
@@ -188,7 +187,7 @@ def solve(w, mu_re, mu_im, logB, s_start, order, kp, c, KT, R, chi, phimax, S, J
     """
     P = mu_re.shape[0]
     N = w.shape[0]
-    for p in range(P):
+    for p in prange(P):  # a plain range unless compiled parallel
         s = s_start[p]
         s_prev = s
         for jj in range(N):
@@ -208,38 +207,8 @@ def solve(w, mu_re, mu_im, logB, s_start, order, kp, c, KT, R, chi, phimax, S, J
             kim_out[p, n] = im
 
 
-@njit(cache=True, parallel=True)
-def solve_parallel(w, mu_re, mu_im, logB, s_start, order, kp, c, KT, R, chi, phimax, S, J1, k3, c2,
-          nodes, weights, tol, s_out, jump_out, kre_out, kim_out):
-    """`solve` with the parameter sets spread over threads (for large batches).
-
-    Amplitudes s = log q (P, N) by continuation along `order` for every parameter set.
-
-    w (N,) rad/s; mu_re, mu_im, logB (P, N); s_start (P,) a guess for the first
-    frequency (below every branch for an up sweep's low end, see `envelope`); parameter
-    arrays (P,). Writes s_out, jump_out and the joint DOF's dynamic stiffness at the
-    solution (kre_out + i kim_out, lbf/in), all (P, N).
-    """
-    P = mu_re.shape[0]
-    N = w.shape[0]
-    for p in prange(P):
-        s = s_start[p]
-        s_prev = s
-        for jj in range(N):
-            n = order[jj]
-            guess = s
-            if jj >= 2:  # continue the branch by linear extrapolation in frequency
-                n1 = order[jj - 1]
-                n2 = order[jj - 2]
-                if w[n1] != w[n2]:
-                    guess = s + (s - s_prev) * (w[n] - w[n1]) / (w[n1] - w[n2])
-            s_prev = s
-            s, jumped, re, im = _root(guess, w[n], mu_re[p, n], mu_im[p, n], logB[p, n], kp[p], c[p], KT[p], R[p],
-                                      chi[p], phimax[p], S[p], J1[p], k3[p], c2[p], nodes, weights, tol)
-            s_out[p, n] = s
-            jump_out[p, n] = jumped and jj > 0
-            kre_out[p, n] = re
-            kim_out[p, n] = im
+solve = njit(cache=True)(_solve)
+solve_parallel = njit(cache=True, parallel=True)(_solve)  # the same kernel with the sets spread over threads
 
 
 @njit(cache=True)
