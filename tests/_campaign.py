@@ -1,6 +1,7 @@
 """Test helpers (not jointcal code): where the small campaign lives and how to break a copy."""
 from __future__ import annotations
 
+import shutil
 from collections.abc import Callable
 from pathlib import Path
 
@@ -25,3 +26,13 @@ def edit_run(campaign: Path, file: str, edit: Callable[[pd.DataFrame], pd.DataFr
     df = read_run(campaign / file)
     df = df if (new := edit(df)) is None else new
     df.to_csv(campaign / file, index=False, float_format="%.9g")
+
+
+def workflow_copy(tmp_path: Path) -> Path:
+    """A copy of Snakefile, workflow/ and profiles/ in tmp_path/wf: the working directory of a workflow run."""
+    work = tmp_path / "wf"
+    work.mkdir()
+    shutil.copy(REPO / "Snakefile", work)
+    for folder in ("workflow", "profiles"):
+        shutil.copytree(REPO / folder, work / folder, ignore=shutil.ignore_patterns("__pycache__"))
+    return work

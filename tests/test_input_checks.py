@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from _campaign import REPO, edit_manifest, edit_run
+from _campaign import REPO, edit_manifest, edit_run, workflow_copy
 from scipy import signal
 
 from jointcal._checks import clip_levels, clipped_mask
@@ -321,12 +321,7 @@ def test_malformed_synth_spec_is_one_sentence(tmp_path, capsys, text, words):
 
 
 def _workdir(tmp_path: Path) -> Path:
-    work = tmp_path / "wf"
-    work.mkdir()
-    shutil.copy(REPO / "Snakefile", work)
-    for folder in ("workflow", "profiles"):
-        shutil.copytree(REPO / folder, work / folder, ignore=shutil.ignore_patterns("__pycache__"))
-    return work
+    return workflow_copy(tmp_path)
 
 
 def _snakemake(work: Path, *args: str) -> subprocess.CompletedProcess[str]:

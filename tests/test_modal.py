@@ -127,11 +127,10 @@ def _merge_run(dst: Path, src: Path, run_id: str, new_id: str, sequence: int) ->
 
 def test_bad_runs_inside_a_valid_campaign_are_flagged_and_the_rest_finish(tmp_path):
     """Workflow: a band that misses the resonance, a clipped response, a NaN burst."""
-    import shutil
     import subprocess
     import sys
 
-    from _campaign import REPO
+    from _campaign import workflow_copy
 
     base = {"seed": 9, "sweep": {"f_start_hz": 1500.0, "f_stop_hz": 2700.0, "rate_hz_per_s": 400.0},
             "series": [{"level_g": 1.0, "directions": ["up", "down"]}], "assemblies": {"first": FIRST}}
@@ -147,11 +146,7 @@ def test_bad_runs_inside_a_valid_campaign_are_flagged_and_the_rest_finish(tmp_pa
     df = read_run(nanfile)
     df.loc[30000:30200, "response_accel_g"] = np.nan
     write_run(nanfile, df["time_s"], df["base_accel_g"], df["response_accel_g"])
-    work = tmp_path / "wf"
-    work.mkdir()
-    shutil.copy(REPO / "Snakefile", work)
-    for folder in ("workflow", "profiles"):
-        shutil.copytree(REPO / folder, work / folder, ignore=shutil.ignore_patterns("__pycache__"))
+    work = workflow_copy(tmp_path)
     out = tmp_path / "results"
     res = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", "modal", "--config",
                           f"raw_data={tmp_path / 'c'}", f"results={out}"], cwd=work, capture_output=True,

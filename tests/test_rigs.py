@@ -132,12 +132,11 @@ def test_rig_model_keeps_the_joint():
 def test_workflow_reads_a_voltage_driven_chirp_campaign(tmp_path):
     """Workflow 'modal_properties' on a voltage-driven beam campaign (eta-20 chirps, up and down):
     ingest takes level_V / drive_V, the modal stage reads the rig's pole, each run's FRF is written."""
-    import shutil
     import subprocess
     import sys
 
     import pandas as pd
-    from _campaign import REPO
+    from _campaign import workflow_copy
 
     spec = {"seed": 8, "sample_rate_hz": 1024.0, "sweep": {"f_start_hz": 70.0, "f_stop_hz": 130.0,
                                                            "rate_hz_per_s": 20.0 * (97.66 * 0.0192) ** 2,
@@ -146,11 +145,7 @@ def test_workflow_reads_a_voltage_driven_chirp_campaign(tmp_path):
             "rig": {"reference": "voltage", "shaker": SHAKER}}
     generate(spec, tmp_path / "c", tmp_path / "t.json")
     truth = json.loads((tmp_path / "t.json").read_text())["runs"]
-    work = tmp_path / "wf"
-    work.mkdir()
-    shutil.copy(REPO / "Snakefile", work)
-    for folder in ("workflow", "profiles"):
-        shutil.copytree(REPO / folder, work / folder, ignore=shutil.ignore_patterns("__pycache__"))
+    work = workflow_copy(tmp_path)
     out = tmp_path / "results"
     res = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", "modal_properties", "--config",
                           f"raw_data={tmp_path / 'c'}", f"results={out}"], cwd=work, capture_output=True,

@@ -1,7 +1,6 @@
 """Run the Snakemake workflow on the small campaign from a copy of the repository's workflow."""
 from __future__ import annotations
 
-import shutil
 import json
 import subprocess
 import sys
@@ -9,7 +8,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
-from _campaign import REPO, edit_run
+from _campaign import REPO, edit_run, workflow_copy
 
 pytestmark = pytest.mark.slow
 
@@ -17,12 +16,7 @@ pytestmark = pytest.mark.slow
 @pytest.fixture
 def workdir(tmp_path: Path) -> Path:
     """A copy of Snakefile, workflow/ and profiles/ (the working directory of each run)."""
-    work = tmp_path / "wf"
-    work.mkdir()
-    shutil.copy(REPO / "Snakefile", work)
-    for folder in ("workflow", "profiles"):
-        shutil.copytree(REPO / folder, work / folder, ignore=shutil.ignore_patterns("__pycache__"))
-    return work
+    return workflow_copy(tmp_path)
 
 
 def _snakemake(work: Path, *args: str) -> subprocess.CompletedProcess[str]:
