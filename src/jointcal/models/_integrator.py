@@ -71,11 +71,12 @@ def rate(u, fs):
 
 @njit(cache=True)
 def run(u, ud, H, Gsub, Wub, Phi, Gf, lz, lv, az, bzu, bzf, cy, dyu, dyf,
-        joint, KT, R, chi, phimax, Fs, sk, sphi, k3, c2, y_out, z_out):
+        joint, KT, R, chi, phimax, Fs, sk, sphi, k3, c2, kc, gap, y_out, z_out):
     """Integrate from rest; write the output y and joint displacement z per input sample.
 
     joint: 0 none, 1 exact Iwan (R and chi passed as R/(chi+1), chi+1), 2 Jenkins
     sliders of stiffness sk and slip displacement sphi (a test reference; KT = sum(sk)).
+    kc, gap: unilateral contact spring kc max(z - gap, 0) (0 disables it).
     Gsub[j] (n, 4) maps the parent interval's Hermite data [u_k, H u'_k, u_k+1, H u'_k+1]
     to the input's contribution over substep j; Wub[j] (4,) gives u at the substep's end.
     """
@@ -171,6 +172,9 @@ def run(u, ud, H, Gsub, Wub, Phi, Gf, lz, lv, az, bzu, bzf, cy, dyu, dyf,
                 if k3 != 0.0:
                     r1 += k3 * z1 * z1 * z1
                     rd1 += 3.0 * k3 * z1 * z1 * v1
+                if kc != 0.0 and z1 > gap:
+                    r1 += kc * (z1 - gap)
+                    rd1 += kc * v1
                 if c2 != 0.0:
                     ub = Wub[j, 0] * p0 + Wub[j, 1] * p1 + Wub[j, 2] * p2 + Wub[j, 3] * p3
                     r1 += c2 * v1 * abs(v1)

@@ -134,6 +134,9 @@ def steady_state(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike = 1.0
     A = np.broadcast_to(np.asarray(base_g, dtype=float), f.shape) * G
     if not np.all(np.isfinite(A) & (A > 0)):
         raise ValueError("steady_state: base_g must be positive and finite (g) at every frequency.")
+    if np.any(np.asarray(model.contact_k) != 0):
+        raise ValueError("steady_state has no first-harmonic model of a unilateral contact (contact_k > 0): its "
+                         "response has a mean offset and even harmonics; use jointcal.models.simulate.")
     iw = model.iwan
     fields = [model.m, model.k, model.zeta_v, model.k3, model.c2, model.sensor_gain, model.sensor_delay_s]
     if iw is not None:

@@ -11,7 +11,7 @@ frequency). Coordinates are relative to the control accelerometer (the base):
 
 M q'' + C q' + K q = -M_b a_base - e_z r_nl, where K holds the STUCK joint stiffness
 KT and r_nl is the nonlinear remainder of the joint restoring force,
-r_nl = F_iwan(z) - KT z + k3 z^3 + c2 z'|z'|. The response channel is the slug's
+r_nl = F_iwan(z) - KT z + k3 z^3 + c2 z'|z'| + k_c max(z - gap, 0). The response channel is the slug's
 absolute acceleration a_base + s.q''. Adding an effect means adding a field here and
 its terms to `state_space` (linear) or to r_nl (nonlinear); the integrator does not
 change. Sensor effects (gain, delay) act on the output channel after integration.
@@ -64,6 +64,12 @@ class MinistackModel:
         Response-channel sensitivity error factor (``sensor_gain``).
     sensor_delay_s : float
         Response-channel delay, s (``channel_delay``).
+    contact_k : float
+        Unilateral contact spring, lbf/in: force contact_k max(z - contact_gap_in, 0)
+        once the slug closes a gap (a stop, a bottomed foam cup). Not in the discrepancy
+        library (a test of an effect outside it); only the time simulation models it.
+    contact_gap_in : float
+        Gap the slug closes before the contact spring engages, in (>= 0).
     """
 
     m: float
@@ -75,6 +81,8 @@ class MinistackModel:
     c2: float = 0.0
     sensor_gain: float = 1.0
     sensor_delay_s: float = 0.0
+    contact_k: float = 0.0
+    contact_gap_in: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("m", "k"):
@@ -85,6 +93,9 @@ class MinistackModel:
             raise ValueError(f"MinistackModel.zeta_v must lie in [0, 1), got {self.zeta_v!r}.")
         if not np.all(np.asarray(self.sensor_gain) > 0):
             raise ValueError(f"sensor_gain must be positive, got {self.sensor_gain!r}.")
+        if not np.all((np.asarray(self.contact_k) >= 0) & (np.asarray(self.contact_gap_in) >= 0)):
+            raise ValueError("contact_k and contact_gap_in must be >= 0 (a contact that pushes back once the gap "
+                             f"closes), got {self.contact_k!r} and {self.contact_gap_in!r}.")
 
     @property
     def KT(self) -> float:

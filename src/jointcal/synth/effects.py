@@ -14,6 +14,11 @@ joint_settling          Fs and KT rise with the run's sequence number n:
                         X_n = X (1 + drift (1 - exp(-(n - 1) / n_settle))).
 quadratic_damping       c2 z'|z'| damper (lbf s^2/in^2): air pumping, foam.
 sensor_gain             response sensitivity off by `gain`, not in the metadata.
+contact_spring          unilateral spring contact_k max(z - gap_in, 0) (lbf/in, in):
+                        the slug meets a stop (a bottomed foam cup) beyond a gap;
+                        asymmetric, so even harmonics and a mean offset. Outside the
+                        discrepancy library on purpose (the workflow must not give it
+                        a wrong library name with high confidence).
 =====================  ==========================================================
 """
 from __future__ import annotations
@@ -34,6 +39,7 @@ EFFECTS: dict[str, dict[str, float]] = {
     "joint_settling": {"Fs_drift": 0.10, "KT_drift": 0.05, "n_settle": 3.0},
     "quadratic_damping": {"c2": 1.2},
     "sensor_gain": {"gain": 1.25},
+    "contact_spring": {"contact_k": 4e5, "gap_in": 8e-5},
 }
 
 
@@ -78,6 +84,8 @@ def run_model(truth: dict, sequence: int, effect: str = "none", params: dict | N
         return replace(model, c2=p["c2"])
     if effect == "sensor_gain":
         return replace(model, sensor_gain=p["gain"])
+    if effect == "contact_spring":
+        return replace(model, contact_k=p["contact_k"], contact_gap_in=p["gap_in"])
     if effect == "joint_settling":
         s = 1.0 - np.exp(-(sequence - 1) / p["n_settle"])
         iw = IwanParams(iwan.Fs * (1 + p["Fs_drift"] * s), iwan.KT * (1 + p["KT_drift"] * s), iwan.chi, iwan.beta)

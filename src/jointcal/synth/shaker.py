@@ -161,7 +161,7 @@ def simulate_rig(model: MinistackModel, shaker: Shaker, volts: NDArray, fs: floa
         _integrator.run(u, _integrator.rate(u, fs), H, Gsub, Wub, np.ascontiguousarray(Phi),
                         np.ascontiguousarray(Gf), lz, lv, az, bzu, bzf, np.ascontiguousarray(cy), float(dyu),
                         float(dyf), joint, KT, R, chi, phimax, Fs, np.zeros(0), np.zeros(0), float(model.k3),
-                        float(model.c2), y, x)
+                        float(model.c2), float(model.contact_k), float(model.contact_gap_in), y, x)
         res[name] = y
     acc = res["accel"]
     if model.sensor_delay_s != 0.0:
