@@ -193,3 +193,23 @@ def test_spec_errors_are_one_sentence(tmp_path):
         load_spec({"seed": 1, "sample_rate_hz": 4000.0})
     with pytest.raises(ValueError, match="must not live inside"):
         generate({"seed": 1}, tmp_path / "c", tmp_path / "c" / "truth.json")
+
+
+@pytest.mark.slow
+def test_contact_spring_acts_beyond_its_gap_with_even_harmonics(effect_lab):
+    """contact_spring (gap 8e-5 in): at 1 g the slug (q ~ 5e-5 in) never reaches the stop, so the run is
+    the base run; at 10 g (q ~ 2.9e-4 in) the stop stiffens the resonance and the asymmetric force puts
+    a 2nd harmonic in the response that dominates the 3rd (the joint's own harmonics are odd)."""
+    from jointcal.modal import measure_run
+    base, eff = effect_lab("none"), effect_lab("contact_spring")
+
+    def props(camp, suffix):
+        man, runs, _ = camp
+        rid = next(r for r in man.index if r.endswith(suffix))
+        return measure_run(runs[rid], {**man.loc[rid].to_dict(), "run_id": rid})[2]
+
+    b1, e1, b10, e10 = props(base, "1g_up"), props(eff, "1g_up"), props(base, "10g_up"), props(eff, "10g_up")
+    assert abs(e1["f_res_hz"] / b1["f_res_hz"] - 1) < 1e-5
+    assert e10["f_res_hz"] / b10["f_res_hz"] - 1 > 0.01
+    assert e10["h2_ratio"] > 10 * b10["h2_ratio"] and e10["h2_ratio"] > 2 * e10["h3_ratio"]
+    assert b10["h2_ratio"] < 0.5 * b10["h3_ratio"]
