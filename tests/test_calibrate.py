@@ -46,6 +46,22 @@ def test_space_round_trip_and_scaling():
     assert SPACE.to_unit([[10.0, 1e6, -0.475, 0.01, 1e6, 0.01]])[0, 2] == pytest.approx(0.5)
 
 
+def test_space_grows_by_named_parameters_with_their_scaling():
+    """ParamSpace.grow appends columns (an effect's), each with its bounds and log/linear scaling;
+    the joint's six columns map exactly as before."""
+    g = SPACE.grow(["gain", "tau_s"], [0.5, 0.0], [2.0, 4e-4], [True, False])
+    assert g.names == (*PARAMS, "gain", "tau_s") and g.ndim == 8
+    u = np.array([0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.5, 0.25])
+    th = g.to_physical(u)
+    np.testing.assert_allclose(th[:6], SPACE.to_physical(u[:6]), rtol=1e-14)
+    assert th[6] == pytest.approx(1.0) and th[7] == pytest.approx(1e-4)  # log mid of [0.5, 2]; linear quarter
+    np.testing.assert_allclose(g.to_unit(th), u, atol=1e-12)
+    with pytest.raises(ValueError, match="log-scaled"):
+        SPACE.grow(["tau_s"], [0.0], [1e-4], [True])
+    with pytest.raises(ValueError, match="repeat"):
+        SPACE.grow(["Fs"], [1.0], [2.0], [True])
+
+
 @pytest.mark.parametrize("bounds, match", [
     ({"Fs": [0.0, 10.0]}, "Fs.*lower bound must be > 0"),
     ({"chi": [-1.2, 0.0]}, "chi must lie in"),

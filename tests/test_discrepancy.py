@@ -55,6 +55,26 @@ def test_effect_parameters_map_to_the_unit_cube_and_back():
         model_at(c, theta, {"sequence": 5})  # every effect builds a model
 
 
+def test_a_new_library_effect_grows_the_space_and_is_fitted_without_other_changes(monkeypatch):
+    """Issue 9: the parameter space grows by an effect's parameters with no code change elsewhere.
+    A new entry (a base-channel gain error, the response read against a base that reads b high:
+    T_read = T / b) is registered in the library only; the fit's space becomes the six joint columns
+    plus b with its bounds and scaling, and the hidden b = 0.9 is recovered and named."""
+    from dataclasses import replace as dc_replace
+    from jointcal.discrepancy.library import Effect, EffectParam
+    new = Effect("base_gain", (EffectParam("b", "-", 0.5, 2.0, True, 1.0, "base channel reading / true"),),
+                 lambda m, v, row: dc_replace(m, sensor_gain=m.sensor_gain / v["b"]), lambda v: "check the base")
+    monkeypatch.setitem(EFFECTS, "base_gain", new)
+    c = candidate("base_gain", SPACE, M)
+    assert c.names == (*PARAMS, "b") and c.grown.ndim == 7 and bool(c.grown.is_log[-1])
+    np.testing.assert_allclose(c.to_unit(np.r_[TRUTH, 1.0])[-1], 0.5)  # log scale: 1 is the middle of [0.5, 2]
+    runs = _runs("base_gain", [0.9])
+    cands = [candidate(n, SPACE, M) for n in ("baseline", "base_gain", "channel_delay")]
+    name, conf, ranked = decide(score_candidates(cands, runs, TRUTH * np.array([1.1, 0.95, 1, 1, 1.05, 1.2]),
+                                                 max_nfev=25))
+    assert name == "base_gain" and abs(ranked[0].fit.theta[6] / 0.9 - 1) < 0.03
+
+
 def test_E_of_the_truth_is_about_one_on_noise_at_the_scatter():
     runs = _runs()
     E = envelope_E(candidate("baseline", SPACE, M), TRUTH, runs)

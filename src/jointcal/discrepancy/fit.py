@@ -9,9 +9,9 @@ through a sweep lags: to first order in the sweep rate r (Hz/s, signed) a quasi-
 sweep shows T(f - r tau_g(f)), tau_g = -d arg T / d omega the group delay, which is
 applied to the model (the fits then do not mistake the sweep's lag for an effect).
 
-Parameters live in a unit cube: the six joint/linear ones on the calibration's scaling
-(`jointcal.calibrate.space`), plus the effect's own (`library.EffectParam`: log or
-linear between its bounds). Bounded least squares (`scipy.optimize.least_squares`) from
+Parameters live in a unit cube: the calibration's space (`jointcal.calibrate.space`)
+grown by the effect's own parameters (`ParamSpace.grow` with `library.EffectParam`'s
+bounds and scaling). Bounded least squares (`scipy.optimize.least_squares`) from
 the baseline calibration and from each of the effect's start values; the Jacobian is one
 batched call of the fast model over the perturbed parameter sets.
 """
@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import NDArray
@@ -34,7 +35,7 @@ __all__ = ["Candidate", "Fit", "candidate", "model_at", "fit_candidate", "envelo
 
 @dataclass(frozen=True)
 class Candidate:
-    """A model to fit: the baseline joint space plus an effect's parameters ('baseline': none)."""
+    """A model to fit: the baseline joint space grown by an effect's parameters ('baseline': none)."""
 
     name: str
     space: ParamSpace
@@ -44,29 +45,23 @@ class Candidate:
     def effect_params(self):
         return () if self.name == "baseline" else EFFECTS[self.name].params
 
+    @cached_property
+    def grown(self) -> ParamSpace:
+        """The calibration's space with the effect's parameters appended (`ParamSpace.grow`)."""
+        e = self.effect_params
+        return self.space.grow([p.name for p in e], [p.lo for p in e], [p.hi for p in e], [p.log for p in e])
+
     @property
     def names(self) -> tuple[str, ...]:
-        return (*PARAMS, *(p.name for p in self.effect_params))
+        return self.grown.names
 
     def to_physical(self, u: NDArray) -> NDArray:
         """Unit cube (..., n) -> physical values (..., n)."""
-        u = np.asarray(u, dtype=float)
-        out = np.empty_like(u)
-        out[..., :6] = self.space.to_physical(u[..., :6])
-        for i, p in enumerate(self.effect_params):
-            x = u[..., 6 + i]
-            out[..., 6 + i] = (10 ** (np.log10(p.lo) + x * np.log10(p.hi / p.lo)) if p.log
-                               else p.lo + x * (p.hi - p.lo))
-        return out
+        return self.grown.to_physical(u)
 
     def to_unit(self, theta: NDArray) -> NDArray:
-        theta = np.asarray(theta, dtype=float)
-        out = np.empty_like(theta)
-        out[..., :6] = self.space.to_unit(theta[..., :6])
-        for i, p in enumerate(self.effect_params):
-            x = theta[..., 6 + i]
-            out[..., 6 + i] = (np.log10(x / p.lo) / np.log10(p.hi / p.lo) if p.log else (x - p.lo) / (p.hi - p.lo))
-        return out
+        """Physical values (..., n) -> unit cube (..., n)."""
+        return self.grown.to_unit(theta)
 
 
 def candidate(name: str, space: ParamSpace, m: float) -> Candidate:
