@@ -118,6 +118,25 @@ def test_the_virtual_lab_hides_two_effects_at_once():
     assert one.sensor_gain == 1.1 and one.iwan.Fs > TRUTH[0] * 1.05  # both present, neither undone
 
 
+def test_an_even_harmonic_no_library_effect_leaves_caps_the_decision():
+    """A dominant 2nd harmonic (an asymmetric contact) is outside the library: a candidate that only
+    partly closes the gap is not named (unexplained); one that closes it to the scatter keeps its name
+    at medium confidence, never high. Small or odd-dominated harmonics change nothing."""
+    from jointcal.discrepancy.fingerprints import outside_library
+    from jointcal.discrepancy.select import Scored
+    assert outside_library({"h2_ratio": 0.07, "h3_ratio": 0.003}) is not None
+    assert outside_library({"h2_ratio": 0.005, "h3_ratio": 0.0001}) is None  # below 1% of the fundamental
+    assert outside_library({"h2_ratio": 0.02, "h3_ratio": 0.03}) is None  # odd harmonics dominate (Iwan, cubic)
+    fit = lambda n: type("F", (), {"E": 1.0, "theta": np.zeros(7)})()  # noqa: E731
+    partly = [Scored("baseline", fit(0), 20.0), Scored("quadratic_damping", fit(1), 5.0), Scored("sensor_gain", fit(1), 15.0)]
+    fully = [Scored("baseline", fit(0), 20.0), Scored("sensor_gain", fit(1), 1.4), Scored("channel_delay", fit(1), 15.0)]
+    why = outside_library({"h2_ratio": 0.07, "h3_ratio": 0.003})
+    assert decide(partly)[:2] == ("quadratic_damping", "medium")
+    assert decide(partly, why)[:2] == ("unexplained", "low")
+    assert decide(fully)[:2] == ("sensor_gain", "high")
+    assert decide(fully, why)[:2] == ("sensor_gain", "medium")
+
+
 def test_bad_settings_are_one_sentence():
     with pytest.raises(ValueError, match="unknown effect"):
         DiscrepancySettings(candidates=("sensor_gain", "gremlins"))

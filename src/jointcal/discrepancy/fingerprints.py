@@ -33,7 +33,9 @@ import pandas as pd
 from .data import RunEnvelope
 from .fit import Candidate, predict
 
-__all__ = ["residual_map", "fingerprints", "verdicts"]
+__all__ = ["residual_map", "fingerprints", "verdicts", "outside_library", "EVEN_HARMONIC"]
+
+EVEN_HARMONIC = 0.01  # 2nd harmonic over the fundamental at the top level above which parity counts
 
 
 def residual_map(c: Candidate, theta, runs: Sequence[RunEnvelope]) -> pd.DataFrame:
@@ -142,3 +144,20 @@ def verdicts(fp: Mapping[str, float | None], sigma_db: float, sigma_f: float) ->
             out[name]["against"].append(f"even harmonics dominate (h2 {h2:.3f} > 2 x h3 {h3:.3f}): an asymmetric "
                                         "(contact) nonlinearity no library effect has")
     return out
+
+
+def outside_library(fp: Mapping[str, float | None]) -> str | None:
+    """A fingerprint no library effect can leave, in words, or None.
+
+    Every library effect is symmetric in the joint displacement (or linear), so none puts
+    a 2nd harmonic in the response. At the top level an even harmonic above
+    `EVEN_HARMONIC` of the fundamental that also dominates the odd one (h2 > 2 h3; the
+    Iwan joint's own harmonics are odd) means an asymmetric nonlinearity -- a contact, a
+    stop, a bottoming foam cup, a rattle -- or a distorting shaker: outside the library.
+    """
+    h2, h3 = fp.get("h2_ratio"), fp.get("h3_ratio")
+    if h2 is not None and h2 > EVEN_HARMONIC and h2 > 2 * (h3 or 0.0):
+        return (f"the response's 2nd harmonic is {h2 * 100:.1f}% of the fundamental at the top level and "
+                f"dominates the 3rd ({(h3 or 0.0) * 100:.2f}%): an asymmetric nonlinearity (a contact or stop that "
+                "engages on one side, a bottoming foam cup) or a distorting shaker, which no library effect models")
+    return None

@@ -18,6 +18,10 @@ Decision rule (scores S; S_b the baseline's, S_1 <= S_2 the two best candidates'
 * ``unexplained`` otherwise: the gap is real and no single library effect closes it (or two
                   close it equally well); the ranked candidates and the fingerprints that
                   disagree with each are reported.
+
+A fingerprint no library effect can leave (`fingerprints.outside_library`: a dominant even
+harmonic) caps the decision: the best name is kept only if it closes the gap to about the
+scatter (S_1 <= 2), and then with confidence 'medium'; otherwise ``unexplained``.
 """
 from __future__ import annotations
 
@@ -77,8 +81,11 @@ def score_candidates(cands: Sequence[Candidate], runs: Sequence[RunEnvelope], th
     return out
 
 
-def decide(scored: Sequence[Scored]) -> tuple[str, str, list[Scored]]:
-    """(effect or 'none'/'unexplained', confidence, candidates ranked by score) by the module's rule."""
+def decide(scored: Sequence[Scored], outside: str | None = None) -> tuple[str, str, list[Scored]]:
+    """(effect or 'none'/'unexplained', confidence, candidates ranked by score) by the module's rule.
+
+    outside : a fingerprint no library effect leaves (`fingerprints.outside_library`), or None.
+    """
     base = next(s for s in scored if s.name == "baseline")
     ranked = sorted((s for s in scored if s.name != "baseline"), key=lambda s: s.score)
     if base.score <= NONE_E:
@@ -89,6 +96,8 @@ def decide(scored: Sequence[Scored]) -> tuple[str, str, list[Scored]]:
     s2 = ranked[1].score if len(ranked) > 1 else np.inf
     closes = base.score - s1 >= CLOSE_FRACTION * (base.score - 1.0)
     decisive = s1 <= MARGIN * s2
+    if closes and decisive and outside and s1 > 2.0:
+        return "unexplained", "low", ranked
     if closes and decisive:
-        return ranked[0].name, "high" if s1 <= 2.0 else "medium", ranked
+        return ranked[0].name, "high" if (s1 <= 2.0 and not outside) else "medium", ranked
     return "unexplained", "low", ranked

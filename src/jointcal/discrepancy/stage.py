@@ -24,7 +24,7 @@ from ..calibrate.space import PARAMS, ParamSpace
 from ..models import harmonic_balance
 from ..validate import ValidateSettings, model_from_best, validate_runs
 from .data import run_envelope, scale_arrays
-from .fingerprints import fingerprints, residual_map, verdicts
+from .fingerprints import fingerprints, outside_library, residual_map, verdicts
 from .fit import candidate, fit_candidate, model_at
 from .library import EFFECTS
 from .select import CLOSE_FRACTION, MARGIN, NONE_E, decide, score_candidates
@@ -128,7 +128,6 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     say(f"{assembly}: {len(runs)} usable runs, {sum(r.f_hz.size for r in runs)} envelope frames")
     cands = [candidate("baseline", space, m)] + [candidate(n, space, m) for n in settings.candidates]
     scored = score_candidates(cands, runs, theta0, max_nfev=settings.max_nfev, log=say)
-    effect, confidence, ranked = decide(scored)
     base = next(s for s in scored if s.name == "baseline")
     # localise: residuals of the baseline refit, fingerprints
     c0 = cands[0]
@@ -143,6 +142,8 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     scatter_f = float(np.sqrt(np.mean(sf**2))) if len(sf) else 1e-4
     fp = fingerprints(res, usable, model_fz, jb, max(scatter_f, 2e-5), m)
     ver = verdicts(fp, float(sdb[-1]), max(scatter_f, 2e-5))
+    outside = outside_library(fp)
+    effect, confidence, ranked = decide(scored, outside)
     cand_out = []
     for s in ranked:
         c = candidate(s.name, space, m)
@@ -178,7 +179,9 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
         "assembly": assembly, "effect": effect, "confidence": confidence,
         "rule": (f"none if the baseline's held-out score <= {NONE_E}; else name the best candidate if it closes "
                  f">= {CLOSE_FRACTION:.0%} of the baseline's excess over 1 and scores <= {MARGIN} x the runner-up "
-                 "(confidence high when its score <= 2); otherwise unexplained"),
+                 "(confidence high when its score <= 2); otherwise unexplained. A fingerprint no library effect "
+                 "leaves (a dominant even harmonic) keeps a name only at score <= 2, with confidence medium"),
+        "outside_library": outside,
         "baseline": {"held_out_score": base.score, "E_fit": base.fit.E, "held_out_E_per_level": base.held_out,
                      "joint_parameters": dict(zip(PARAMS, map(float, base.fit.theta[:6])))},
         "candidates": cand_out, "fingerprints": fp,
@@ -208,6 +211,8 @@ def diagnosis_markdown(d: Mapping) -> str:
                   "base record.", ""]
         if c["fingerprints_for"]:
             lines += ["Evidence: " + "; ".join(c["fingerprints_for"]) + ".", ""]
+        if d.get("outside_library"):
+            lines += ["But something else is there too: " + d["outside_library"] + ".", ""]
         ep = d["recalibrated"]["effect_parameters"]
         bounds = {p.name: (p.lo, p.hi) for p in EFFECTS[d["effect"]].params}
         for k, v in ep.items():
@@ -225,7 +230,9 @@ def diagnosis_markdown(d: Mapping) -> str:
         for c in d["candidates"][:3]:
             lines.append(f"- `{c['name']}`: held-out score {c['held_out_score']:.2f}; against it: "
                          + ("; ".join(c["fingerprints_against"][:2]) or "nothing"))
-        lines += ["", "Look for a second effect or one outside the library (e.g. a contact, a second mode)."]
+        lines += ["", ("What the library cannot explain: " + d["outside_library"] + "."
+                       if d.get("outside_library") else
+                       "Look for a second effect or one outside the library (e.g. a contact, a second mode).")]
     lines += ["", "| model | held-out score |", "|---|---|", f"| baseline | {d['baseline']['held_out_score']:.2f} |"]
     lines += [f"| {c['name']} | {c['held_out_score']:.2f} |" for c in d["candidates"]]
     return "\n".join(lines) + "\n"
