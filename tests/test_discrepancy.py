@@ -187,6 +187,8 @@ def test_end_to_end_hidden_gain_is_named_and_the_gap_shrinks(tmp_path):
     print(f"\n{d['effect']} ({d['confidence']}): E {d['metric_before']:.2f} -> {d['metric_after']:.2f}; "
           "|log error| of the joint parameters, calibration -> recalibrated: "
           + ", ".join(f"{p} {a:.3f} -> {b:.3f}" for p, (a, b) in err.items()))
+    print("90% intervals (GA + emcee):", {p: [f"{v:.4g}" for v in after[p]["interval_90"]] for p in after},
+          d["recalibrated"]["effect_parameters"]["gain"]["interval_90"], d["recalibrated"]["method"])
     assert d["effect"] == "sensor_gain"
     gain = d["recalibrated"]["effect_parameters"]["gain"]["value"]
     assert abs(gain / 1.12 - 1) < 0.01

@@ -147,7 +147,8 @@ def _stats() -> tools.Statistics:
 
 def run_ga(batch: BatchObjective, ndim: int, options: GAOptions = GAOptions(), *,
            resume: dict[str, Any] | None = None,
-           on_checkpoint: Callable[[dict[str, Any]], None] | None = None) -> GAResult:
+           on_checkpoint: Callable[[dict[str, Any]], None] | None = None,
+           init: NDArray[np.float64] | None = None) -> GAResult:
     """Minimise a batch objective over [0, 1]^ndim with DEAP.
 
     Parameters
@@ -165,6 +166,9 @@ def run_ga(batch: BatchObjective, ndim: int, options: GAOptions = GAOptions(), *
     on_checkpoint : callable, optional
         Called with a picklable state dict every ``checkpoint_every`` generations and
         at the end.
+    init : ndarray (k, ndim), optional
+        Known good points of the unit cube (e.g. earlier optima) that replace the first k
+        members of the seeded random initial population (clipped to [0, 1]).
 
     Returns
     -------
@@ -177,7 +181,11 @@ def run_ga(batch: BatchObjective, ndim: int, options: GAOptions = GAOptions(), *
     if resume is None:
         random.seed(opt.seed)
         rng = np.random.default_rng(opt.seed)
-        pop = [creator.JointcalIndividual(row) for row in rng.random((opt.population, ndim)).tolist()]
+        start = rng.random((opt.population, ndim))
+        if init is not None and len(init):
+            k = min(len(init), opt.population)
+            start[:k] = np.clip(np.asarray(init, dtype=float).reshape(-1, ndim)[:k], 0.0, 1.0)
+        pop = [creator.JointcalIndividual(row) for row in start.tolist()]
         logbook = tools.Logbook()
         logbook.header = ["gen", "nevals", "min", "median", "max", "best", "sigma"]
         history: list = []

@@ -5,17 +5,18 @@
 2. Candidates: the baseline and every library effect (`library.EFFECTS`), each refit on
    the envelopes through the fast model (`fit`), scored on held-out levels (`select`).
 3. Decide by `select.decide`'s rule.
-4. Act: the named effect's model, fitted jointly with the joint parameters (bounded
-   least squares from the GA optimum; approximate 90% intervals from the Gauss-Newton
-   covariance), revalidated by the TIME simulation driven by each run's measured base
-   record (`jointcal.validate.validate_runs`, the validation stage's E: same definition,
-   same runs) -> metric_before, metric_after.
+4. Act: the named effect's model recalibrated with the joint parameters (`recalibrate`:
+   DEAP GA over the grown space seeded with the least-squares fits from the calibration's
+   optimum and its other valleys, polish, emcee posterior for the 90% intervals),
+   revalidated by the TIME simulation driven by each run's measured base record
+   (`jointcal.validate.validate_runs`, the validation stage's E: same definition, same
+   runs) -> metric_before, metric_after.
 """
 from __future__ import annotations
 
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 import pandas as pd
@@ -26,6 +27,7 @@ from ..validate import ValidateSettings, model_from_best, validate_runs
 from .data import run_envelope, scale_arrays
 from .fingerprints import fingerprints, outside_library, residual_map, verdicts
 from .fit import candidate, fit_candidate, model_at
+from .recalibrate import recalibrate
 from .library import EFFECTS
 from .select import CLOSE_FRACTION, MARGIN, NONE_E, decide, score_candidates
 
@@ -35,12 +37,16 @@ __all__ = ["DiscrepancySettings", "diagnose", "diagnosis_markdown", "valley_star
 @dataclass(frozen=True)
 class DiscrepancySettings:
     """The ``discrepancy:`` config section: candidates (library names), band (fractions of f_res),
-    max_frames per run, max_nfev of each least-squares fit."""
+    max_frames per run, max_nfev of each least-squares fit, the recalibration's GA generations and
+    posterior steps, and its seed."""
 
     candidates: tuple[str, ...] = tuple(EFFECTS)
     band: tuple[float, float] = (0.6, 1.4)
     max_frames: int = 80
     max_nfev: int = 25
+    ga_generations: int = 30
+    posterior_steps: int = 800
+    seed: int = 2017
 
     def __post_init__(self) -> None:
         bad = [c for c in self.candidates if c not in EFFECTS]
@@ -49,6 +55,9 @@ class DiscrepancySettings:
                              f"{', '.join(EFFECTS)}.")
         if not (0 < self.band[0] < 1 < self.band[1]):
             raise ValueError(f"discrepancy.band must be [lo, hi] with 0 < lo < 1 < hi, got {list(self.band)!r}.")
+        if self.ga_generations < 1 or self.posterior_steps < 100:
+            raise ValueError("discrepancy.ga_generations must be >= 1 and posterior_steps >= 100, got "
+                             f"{self.ga_generations!r} and {self.posterior_steps!r}.")
         if self.max_frames < 16 or self.max_nfev < 5:
             raise ValueError("discrepancy.max_frames must be >= 16 and max_nfev >= 5, got "
                              f"{self.max_frames!r} and {self.max_nfev!r}.")
@@ -56,7 +65,7 @@ class DiscrepancySettings:
     @classmethod
     def from_config(cls, section: Mapping | None) -> DiscrepancySettings:
         section = dict(section or {})
-        unknown = sorted(set(section) - {"candidates", "band", "max_frames", "max_nfev"})
+        unknown = sorted(set(section) - {f.name for f in fields(cls)})
         if unknown:
             raise ValueError(f"discrepancy: unknown key(s) {', '.join(unknown)}")
         for key in ("candidates", "band"):
@@ -158,12 +167,17 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     named = next((s for s in ranked if s.name == effect), None)
     final = named if named is not None else base
     cf = candidate(final.name, space, m)
+    fits = [final.fit]
     for th in joint_starts:  # the final model from the GA's other valleys too
         start = np.r_[np.asarray(th, dtype=float)[:6], final.fit.theta[6:]]
         alt = fit_candidate(cf, runs, start, starts=1, max_nfev=2 * settings.max_nfev)
-        say(f"{assembly}: {final.name} refit from Fs = {th[0]:.3g} lbf: E {alt.E:.2f} (kept: {final.fit.E:.2f})")
-        if alt.E < final.fit.E:
-            final = type(final)(final.name, alt, final.score, final.held_out, final.seconds)
+        say(f"{assembly}: {final.name} refit from Fs = {th[0]:.3g} lbf: E {alt.E:.2f}")
+        fits.append(alt)
+    rec = recalibrate(cf, runs, fits, seed=settings.seed, generations=settings.ga_generations,
+                      steps=settings.posterior_steps, max_nfev=2 * settings.max_nfev)
+    say(f"{assembly}: {final.name} recalibrated: GA best E {rec.ga_best_E:.2f} ({rec.ga_generations} generations), "
+        f"polished E {rec.fit.E:.2f}; emcee {rec.steps} steps, tau {rec.tau_max:.0f}")
+    final = type(final)(final.name, rec.fit, final.score, final.held_out, final.seconds)
     models_after = {r["run_id"]: model_at(cf, final.fit.theta, r) for r in rows}
     say(f"{assembly}: decision {effect} ({confidence}); revalidating with the time simulation")
     v_after = validate_runs([models_after[r["run_id"]] for r in rows], records, rows, settings=validate_settings,
@@ -173,7 +187,7 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
                                  envelopes_kw=envelopes_kw, modal_kw=modal_kw, executor=executor)
         metric_before = float(v_before.error["E"])
     metric_after = float(v_after.error["E"])
-    joint_after = {p: {"value": float(final.fit.theta[i]), "interval_90": _interval(final.fit, cf, i)}
+    joint_after = {p: {"value": float(final.fit.theta[i]), "interval_90": rec.interval(i)}
                    for i, p in enumerate(PARAMS)}
     diagnosis = {
         "assembly": assembly, "effect": effect, "confidence": confidence,
@@ -189,8 +203,14 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
         "metric_change": metric_after / metric_before - 1.0 if metric_before else None,
         "recalibrated": {"model": final.name, "joint_parameters": joint_after, "E_fit": final.fit.E,
                          "effect_parameters": {p.name: {"value": float(final.fit.theta[6 + i]), "unit": p.unit,
-                                                        "interval_90": _interval(final.fit, cf, 6 + i)}
-                                               for i, p in enumerate(cf.effect_params)}},
+                                                        "interval_90": rec.interval(6 + i)}
+                                               for i, p in enumerate(cf.effect_params)},
+                         "method": (f"DEAP GA ({rec.ga_generations} generations, best E {rec.ga_best_E:.3g}) seeded "
+                                    f"with {len(fits)} least-squares fits, polished; emcee {rec.steps} steps x 32 "
+                                    f"walkers, max tau {rec.tau_max:.0f} steps"
+                                    + ("" if rec.converged else " (short of 50 tau: intervals approximate)")
+                                    + "; intervals are the 5-95% posterior quantiles"),
+                         "posterior_converged": rec.converged},
         "calibration_joint_parameters": dict(zip(PARAMS, map(float, theta0))),
         "words_after": v_after.words, "seconds": time.perf_counter() - t_start,
     }
