@@ -111,9 +111,9 @@ SERIES = [{"level_g": 1.0, "directions": ["up", "down"], "repeats": 2},
           {"level_g": 10.0, "directions": ["up", "down"], "repeats": 1}]
 
 
-def _campaign(tmp: Path, effect: dict) -> tuple[list, list, dict, dict]:
+def _campaign(tmp: Path, effect: dict, measurement: dict | None = None) -> tuple[list, list, dict, dict]:
     spec = {"seed": 41, "series": SERIES, "assemblies": {"first": TRUTH}, "effect": effect,
-            "sweep": {"f_start_hz": 1600.0, "f_stop_hz": 2600.0}}
+            "sweep": {"f_start_hz": 1600.0, "f_stop_hz": 2600.0}, "measurement": measurement or {}}
     generate(spec, tmp / "campaign", tmp / "truth.json")
     table = modal_table(tmp / "campaign")
     write_csv_atomic(table, tmp / "modal_properties.csv")
@@ -128,18 +128,34 @@ def _campaign(tmp: Path, effect: dict) -> tuple[list, list, dict, dict]:
 def test_E_of_the_calibrated_model_is_at_the_noise_floor_and_grows_with_a_hidden_effect(tmp_path):
     """Issue 8: E(calibrated) <= 1.5 E(true model) without an effect; >= 3x with sensor_gain 1.15.
 
-    One assembly, 1 g x2 repeats up/down, 5 g and 10 g, band 1600-2600 Hz (CI time).
-    Measured when written: E true 0.55, calibrated 0.68, sensor_gain 16.5.
+    One assembly, 1 g x2 repeats up/down, 5 g and 10 g, band 1600-2600 Hz (CI time). The true
+    model's E is the noise floor only where noise sets the scale: the campaigns carry 2% sensor
+    noise (the repeat scatter then exceeds E's 0.05 dB / 0.3 deg floors near resonance). At the
+    virtual lab's default 0.3% the scale is the floors, far above the noise: E(true) = 0.11 and
+    E(calibrated) = 0.28 (the eq. 3.9 optimum misses f by 0.02% and zeta by 0.2%), both far
+    inside the scatter; that campaign checks the simulation itself: the true model driven by the
+    measured base records reproduces every run's measured resonance within 1e-4 and damping
+    within 0.2% through the same chain (measured 4e-5 and 0.09%; with the input taken as cubic
+    between samples, before the band-limited reconstruction, 1e-3 and 1.8%). Measured: 2% noise: E true 0.53, calibrated 0.63;
+    sensor_gain 1.15: 16.
     """
-    rows, records, best, truth = _campaign(tmp_path / "none", {"name": "none"})
+    rows, records, best, truth = _campaign(tmp_path / "exact", {"name": "none"})
     a = truth["assemblies"]["first"]
     with ProcessPoolExecutor(max_workers=2) as ex:
+        v_exact = validate_runs([run_model(a, r["sequence"]) for r in rows], records, rows, executor=ex)
+        noisy = {"noise_fraction": 0.02}
+        rows, records, best, truth = _campaign(tmp_path / "none", {"name": "none"}, noisy)
         e_true = validate_runs([run_model(a, r["sequence"]) for r in rows], records, rows, executor=ex).error["E"]
         e_cal = validate_runs(lambda r: model_from_best(best), records, rows, executor=ex).error["E"]
-        rows, records, best_g, _ = _campaign(tmp_path / "gain", {"name": "sensor_gain", "params": {"gain": 1.15}})
+        rows, records, best_g, _ = _campaign(tmp_path / "gain", {"name": "sensor_gain", "params": {"gain": 1.15}},
+                                             noisy)
         v_gain = validate_runs(lambda r: model_from_best(best_g), records, rows, executor=ex)
-    print(f"\nE: true model {e_true:.2f}, calibrated {e_cal:.2f}, calibrated on a sensor_gain 1.15 campaign "
+    m = v_exact.metrics
+    print(f"\nexact model at 0.3% noise: E {v_exact.error['E']:.2f}, max |f_res error| "
+          f"{m['f_res_rel_err'].abs().max():.1e}, max |zeta error| {m['zeta_rel_err'].abs().max():.1e}\n"
+          f"2% noise: E true model {e_true:.2f}, calibrated {e_cal:.2f}, calibrated on a sensor_gain 1.15 campaign "
           f"{v_gain.error['E']:.2f}\n{v_gain.words}")
+    assert m["f_res_rel_err"].abs().max() < 1e-4 and m["zeta_rel_err"].abs().max() < 2e-3
     assert e_cal <= 1.5 * e_true
     assert v_gain.error["E"] >= 3 * e_cal
 

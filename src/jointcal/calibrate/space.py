@@ -124,7 +124,7 @@ class ParamSpace:
     def to_physical(self, u: ArrayLike) -> NDArray[np.float64]:
         """Unit-cube coordinates (..., n) to physical parameters (..., n)."""
         x = self.x_lo + np.asarray(u, dtype=float) * (self.x_hi - self.x_lo)
-        return np.where(self.is_log, 10.0**x, x)
+        return np.where(self.is_log, 10.0 ** np.where(self.is_log, x, 0.0), x)  # no power of a linear column
 
     def to_unit(self, p: ArrayLike) -> NDArray[np.float64]:
         """Physical parameters (..., n) to unit-cube coordinates (..., n) (not clipped)."""

@@ -16,8 +16,8 @@ fixture_flexibility    f_can_hz (Hz), m_can_ratio (-)                 can/fixtur
                                                                       the joint (zeta_can 1%)
 cubic_stiffening       k3 (lbf/in^3)                                  k3 z^3 spring beside the joint
 quadratic_damping      c2 (lbf s^2/in^2)                              c2 z'|z'| damper (air, foam)
-joint_settling         Fs_drift (-), KT_drift (-)                     Fs, KT rise with the run sequence n:
-                                                                      X (1 + d (1 - exp(-(n-1)/3)))
+joint_settling         Fs_drift (-), KT_drift (-), n_settle (runs)    Fs, KT rise with the run sequence n:
+                                                                      X (1 + d (1 - exp(-(n-1)/n_settle)))
 =====================  =============================================  =====================================
 """
 from __future__ import annotations
@@ -31,7 +31,7 @@ from ..models import Fixture, IwanParams, MinistackModel
 
 __all__ = ["EffectParam", "Effect", "EFFECTS", "apply_effect"]
 
-N_SETTLE = 3.0  # runs over which a settling joint approaches its final state
+N_SETTLE = 3.0  # start value of the settling time, runs
 
 
 @dataclass(frozen=True)
@@ -62,7 +62,7 @@ def _fixture(m: MinistackModel, v, row) -> MinistackModel:
 
 
 def _settling(m: MinistackModel, v, row) -> MinistackModel:
-    s = 1.0 - np.exp(-(float(row.get("sequence", 1)) - 1.0) / N_SETTLE)
+    s = 1.0 - np.exp(-(float(row.get("sequence", 1)) - 1.0) / v["n_settle"])
     iw = m.iwan
     return replace(m, iwan=IwanParams(iw.Fs * (1 + v["Fs_drift"] * s), iw.KT * (1 + v["KT_drift"] * s), iw.chi, iw.beta))
 
@@ -101,10 +101,11 @@ EFFECTS: dict[str, Effect] = {e.name: e for e in (
                       "(Masing) joint gives: look for air pumping through vents or foam cells; add the damper")),
     Effect("joint_settling",
            (EffectParam("Fs_drift", "-", -0.5, 1.0, False, 0.05, "relative rise of Fs over the run sequence"),
-            EffectParam("KT_drift", "-", -0.5, 1.0, False, 0.05, "relative rise of KT over the run sequence")),
+            EffectParam("KT_drift", "-", -0.5, 1.0, False, 0.05, "relative rise of KT over the run sequence"),
+            EffectParam("n_settle", "runs", 0.5, 20.0, True, N_SETTLE, "runs over which the joint settles (1/e)")),
            _settling,
            lambda v: (f"the joint settled during the test (Fs {v['Fs_drift'] * 100:+.0f}%, KT {v['KT_drift'] * 100:+.0f}% "
-                      "from the first runs to the last): run low-level sweeps until they repeat before the test "
+                      f"over about {v['n_settle']:.1f} runs): run low-level sweeps until they repeat before the test "
                       "series, or calibrate on the settled runs only")),
 )}
 

@@ -10,7 +10,11 @@ runs' noise predicts the unseen level no better), and a further complexity penal
 Decision rule (scores S; S_b the baseline's, S_1 <= S_2 the two best candidates'):
 
 * ``none``        when S_b <= `NONE_E` (the baseline already predicts unseen levels within
-                  1.5x the measured repeat scatter);
+                  1.5x the measured repeat scatter) -- unless the best candidate predicts
+                  them far better still, S_1 <= `WITHIN_SCATTER` S_b, and decisively
+                  (S_1 <= MARGIN S_2): then the "scatter" itself is systematic (repeats
+                  that drift with the sequence inflate the repeat scatter they are judged
+                  by) and the candidate is named with confidence 'medium';
 * the best name   when it closes at least `CLOSE_FRACTION` of the baseline's excess gap,
                   S_b - S_1 >= CLOSE_FRACTION (S_b - 1), AND beats the runner-up decisively,
                   S_1 <= `MARGIN` S_2; confidence 'high' if it also reaches S_1 <= 2 (the
@@ -34,12 +38,13 @@ import numpy as np
 from .data import RunEnvelope
 from .fit import Candidate, Fit, envelope_E, fit_candidate
 
-__all__ = ["NONE_E", "CLOSE_FRACTION", "MARGIN", "PENALTY_PER_PARAM", "Scored", "score_candidates", "decide"]
+__all__ = ["NONE_E", "CLOSE_FRACTION", "MARGIN", "PENALTY_PER_PARAM", "WITHIN_SCATTER", "Scored", "score_candidates", "decide"]
 
 NONE_E = 1.5
 CLOSE_FRACTION = 0.6
 MARGIN = 0.7
 PENALTY_PER_PARAM = 0.02
+WITHIN_SCATTER = 0.5
 
 
 @dataclass
@@ -88,12 +93,14 @@ def decide(scored: Sequence[Scored], outside: str | None = None) -> tuple[str, s
     """
     base = next(s for s in scored if s.name == "baseline")
     ranked = sorted((s for s in scored if s.name != "baseline"), key=lambda s: s.score)
+    s1 = ranked[0].score if ranked else np.inf
+    s2 = ranked[1].score if len(ranked) > 1 else np.inf
     if base.score <= NONE_E:
-        return "none", "high" if (not ranked or ranked[0].score > 0.8 * base.score) else "medium", ranked
+        if s1 <= WITHIN_SCATTER * base.score and s1 <= MARGIN * s2 and not outside:
+            return ranked[0].name, "medium", ranked
+        return "none", "high" if (not ranked or s1 > 0.8 * base.score) else "medium", ranked
     if not ranked:
         return "unexplained", "low", ranked
-    s1 = ranked[0].score
-    s2 = ranked[1].score if len(ranked) > 1 else np.inf
     closes = base.score - s1 >= CLOSE_FRACTION * (base.score - 1.0)
     decisive = s1 <= MARGIN * s2
     if closes and decisive and outside and s1 > 2.0:

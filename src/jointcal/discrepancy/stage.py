@@ -29,7 +29,7 @@ from .fingerprints import fingerprints, outside_library, residual_map, verdicts
 from .fit import candidate, fit_candidate, model_at
 from .recalibrate import recalibrate
 from .library import EFFECTS
-from .select import CLOSE_FRACTION, MARGIN, NONE_E, decide, score_candidates
+from .select import CLOSE_FRACTION, MARGIN, NONE_E, WITHIN_SCATTER, decide, score_candidates
 
 __all__ = ["DiscrepancySettings", "diagnose", "diagnosis_markdown", "valley_starts"]
 
@@ -110,7 +110,8 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     ----------
     envs : run_id -> envelopes DataFrame; modal : modal_properties.csv rows (all assemblies);
     best : the calibration's ga_best.json; scale : the validation's repeat-scatter bins
-    (summary.json's "scale"); records, rows : measured records and manifest rows of the
+    (summary.json's "scale"; None: the calibrated model is validated here first, as the
+    validation stage does, and its scale and E are used); records, rows : measured records and manifest rows of the
     assembly's runs (for the time-simulation revalidation); metric_before : the validation
     stage's E (recomputed when None); joint_starts : further joint parameter sets (6,) from
     which the final model is also refit (e.g. the GA's best individual in each other valley:
@@ -120,6 +121,11 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     t_start = time.perf_counter()
     m = float(best["m"])
     theta0 = np.array([best[p] for p in PARAMS], dtype=float)
+    if scale is None:  # as the validation stage does: the calibrated model's E and the measured repeat scatter
+        v_before = validate_runs([model_from_best(best) for _ in rows], records, rows, settings=validate_settings,
+                                 envelopes_kw=envelopes_kw, modal_kw=modal_kw, executor=executor)
+        scale = v_before.scale.to_dict(orient="records")
+        metric_before = float(v_before.error["E"]) if metric_before is None else metric_before
     sdb, sdeg = scale_arrays(scale)
     mrows = modal[modal["assembly"] == assembly].set_index("run_id")
     runs = []
@@ -191,7 +197,8 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
                    for i, p in enumerate(PARAMS)}
     diagnosis = {
         "assembly": assembly, "effect": effect, "confidence": confidence,
-        "rule": (f"none if the baseline's held-out score <= {NONE_E}; else name the best candidate if it closes "
+        "rule": (f"none if the baseline's held-out score <= {NONE_E} (unless the best candidate scores <= "
+                 f"{WITHIN_SCATTER} x the baseline and <= {MARGIN} x the runner-up: named, medium); else name the best candidate if it closes "
                  f">= {CLOSE_FRACTION:.0%} of the baseline's excess over 1 and scores <= {MARGIN} x the runner-up "
                  "(confidence high when its score <= 2); otherwise unexplained. A fingerprint no library effect "
                  "leaves (a dominant even harmonic) keeps a name only at score <= 2, with confidence medium"),
