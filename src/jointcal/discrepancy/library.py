@@ -55,6 +55,7 @@ class Effect:
     params: tuple[EffectParam, ...]
     apply: Callable[[MinistackModel, Mapping[str, float], Mapping], MinistackModel]
     advice: Callable[[Mapping[str, float]], str]
+    sequence_dependent: bool = False  # the model changes with the run's place in the test sequence
 
 
 def _fixture(m: MinistackModel, v, row) -> MinistackModel:
@@ -106,7 +107,8 @@ EFFECTS: dict[str, Effect] = {e.name: e for e in (
            _settling,
            lambda v: (f"the joint settled during the test (Fs {v['Fs_drift'] * 100:+.0f}%, KT {v['KT_drift'] * 100:+.0f}% "
                       f"over about {v['n_settle']:.1f} runs): run low-level sweeps until they repeat before the test "
-                      "series, or calibrate on the settled runs only")),
+                      "series, or calibrate on the settled runs only"),
+           sequence_dependent=True),
 )}
 
 

@@ -14,6 +14,10 @@
    intervals are approximate. Walkers start in a small ball around the polished optimum;
    the chain runs until 50 autocorrelation times or `steps`; the 90% intervals are the
    5-95% quantiles of the chain's second half.
+
+beta is held (GA and chain) at the value of the best least-squares fit, as those fits hold
+it: the envelopes barely constrain it, and left free it drags the Fs-KT-k split into other
+valleys of equal E. Its reported interval is that single value.
 """
 from __future__ import annotations
 
@@ -24,6 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..calibrate.ga import GAOptions, run_ga
+from ..calibrate.space import PARAMS
 from ..posterior.sampler import run_chain
 from .data import RunEnvelope
 from .fit import Candidate, Fit, fit_candidate, residuals
@@ -69,35 +74,44 @@ def recalibrate(c: Candidate, runs: Sequence[RunEnvelope], starts: Sequence[Fit]
     """
     space = c.grown
     n = space.ndim
+    # beta is held where the least-squares fits hold it (see the module notes)
+    free = np.ones(n, bool)
+    free[PARAMS.index("beta")] = False
+    held = [np.clip(c.to_unit(min(starts, key=lambda f: f.E).theta), 0.0, 1.0)]
 
-    def batch(U: NDArray) -> NDArray:
-        U = np.atleast_2d(U)
-        return np.sum(residuals(c, c.to_physical(U), runs) ** 2, axis=-1)
+    def full(V: NDArray) -> NDArray:
+        U = np.repeat(held[0][None], len(V), axis=0)
+        U[:, free] = V
+        return U
 
-    init = np.array([np.clip(c.to_unit(f.theta), 0.0, 1.0) for f in starts]).reshape(-1, n)
-    ga = run_ga(batch, n, GAOptions(population=population, offspring=population, generations=generations,
-                                    stall_generations=8, seed=seed), init=init)
-    pol = fit_candidate(c, runs, c.to_physical(ga.best), starts=1, max_nfev=max_nfev)
+    def batch(V: NDArray) -> NDArray:
+        return np.sum(residuals(c, c.to_physical(full(np.atleast_2d(V))), runs) ** 2, axis=-1)
+
+    init = np.array([np.clip(c.to_unit(f.theta), 0.0, 1.0)[free] for f in starts]).reshape(-1, int(free.sum()))
+    ga = run_ga(batch, int(free.sum()), GAOptions(population=population, offspring=population,
+                                                   generations=generations, stall_generations=8, seed=seed), init=init)
+    pol = fit_candidate(c, runs, c.to_physical(full(ga.best[None])[0]), starts=1, max_nfev=max_nfev)
     best = min([pol, *starts], key=lambda f: f.E)
+    held[0] = np.clip(c.to_unit(best.theta), 0.0, 1.0)  # the chain holds beta at the chosen fit's value
     n_res = residuals(c, best.theta, runs).size
     temp = max(best.E**2, 1.0)
 
-    def log_prob(U: NDArray) -> NDArray:
-        inside = np.all((U >= 0.0) & (U <= 1.0), axis=1)
-        out = np.full(U.shape[0], -np.inf)
+    def log_prob(V: NDArray) -> NDArray:
+        inside = np.all((V >= 0.0) & (V <= 1.0), axis=1)
+        out = np.full(V.shape[0], -np.inf)
         if inside.any():
-            out[inside] = -0.5 * n_res * batch(U[inside]) / temp
+            out[inside] = -0.5 * n_res * batch(V[inside]) / temp
         return out
 
-    u0 = np.clip(c.to_unit(best.theta), 1e-4, 1 - 1e-4)
-    # the Gauss-Newton width, within [0.003, 0.01] of the unit cube: a parameter the polish held
-    # (beta) or a flat direction must not start as a point, or the ensemble explores it too slowly
-    sd = np.sqrt(np.clip(np.diag(best.cov_unit), 9e-6, 1e-4))
+    u0 = np.clip(held[0][free], 1e-4, 1 - 1e-4)
+    # the Gauss-Newton width, within [0.003, 0.01] of the unit cube: a flat direction must not
+    # start as a point, or the ensemble explores it too slowly
+    sd = np.sqrt(np.clip(np.diag(best.cov_unit)[free], 9e-6, 1e-4))
     rng = np.random.default_rng(seed)
-    x0 = np.clip(u0 + rng.standard_normal((walkers, n)) * sd, 0.0, 1.0)
+    x0 = np.clip(u0 + rng.standard_normal((walkers, u0.size)) * sd, 0.0, 1.0)
     ch = run_chain(log_prob, x0, seed=seed, max_steps=steps, chunk=max(50, steps // 4), stop_projected=0.0)
-    keep = ch.chain[len(ch.chain) // 2:].reshape(-1, n)
-    phys = c.to_physical(keep)
+    keep = ch.chain[len(ch.chain) // 2:].reshape(-1, u0.size)
+    phys = c.to_physical(full(keep))
     q05, q50, q95 = np.quantile(phys, [0.05, 0.5, 0.95], axis=0)
     return Recalibration(space.names, best, float(np.sqrt(ga.best_value)), int(ga.generations), q05, q50, q95,
                          int(len(ch.chain)), float(np.max(ch.tau)), bool(ch.converged),
