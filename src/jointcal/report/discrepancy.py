@@ -86,11 +86,14 @@ def table_3_2_corrected_html(best: Mapping[str, Mapping], diagnoses: Mapping[str
         rows.append(f"<tr><td>{a}</td><td>paper's model (eq. 3.9 optimum)</td>"
                     + "".join(f"<td>{b[p]:.4g}</td>" for p in PARAMS) + f"<td>-</td><td>{d['metric_before']:.2f}</td></tr>")
         rows.append(f"<tr><td>{a}</td><td>corrected: {rec['model']} ({d['effect']}, {d['confidence']})</td>"
-                    + "".join(f"<td>{rec['joint_parameters'][p]['value']:.4g}</td>" for p in PARAMS)
+                    + "".join(f"<td>{rec['joint_parameters'][p]['value']:.4g}"
+                              + ("<br><small>90%: {:.3g}-{:.3g}</small>".format(*rec["joint_parameters"][p]["interval_90"])
+                                 if rec["joint_parameters"][p].get("interval_90") else "") + "</td>" for p in PARAMS)
                     + f"<td>{eff}</td><td>{d['metric_after']:.2f}</td></tr>")
     return ("<html><head><meta charset='utf-8'><style>td,th{padding:3px 8px;border-bottom:1px solid #ccc;"
             "font-family:sans-serif;font-size:13px}</style></head><body>"
             "<h3>Table 3.2: the paper's model and the corrected one</h3><table><tr><th>assembly</th><th>model</th>"
             + head + "<th>effect</th><th>validation E</th></tr>" + "".join(rows) + "</table>"
             "<p>E: validation envelope error, time simulation driven by the measured base records "
-            "(1 = the measured repeat scatter).</p></body></html>")
+            "(1 = the measured repeat scatter). 90%: the corrected model's posterior interval (emcee on the "
+            "envelopes; approximate, see diagnosis.json's recalibrated.method).</p></body></html>")
