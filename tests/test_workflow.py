@@ -75,7 +75,7 @@ def test_default_config_runs_on_the_example_campaign(workdir, tmp_path):
     # example's hidden can flexibility is named); test_posterior and test_discrepancy check the methods
     (workdir / "short.yaml").write_text("posterior: {max_steps: 2000, chunk: 500}\nvalidate: {n_draws: 2}\n"
                                         "discrepancy: {candidates: [sensor_gain, channel_delay, fixture_flexibility], "
-                                        "max_nfev: 15}\n")
+                                        "max_nfev: 15, ga_generations: 5, posterior_steps: 200}\n")
     res = _snakemake(workdir, "--cores", "2", "--configfile", "short.yaml", "--config", f"results={out}")
     assert res.returncode == 0, res.stderr
     runs = pd.read_csv(out / "ingest" / "runs.csv")
