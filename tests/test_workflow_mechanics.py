@@ -169,6 +169,27 @@ def test_editing_a_stage_module_reruns_that_stage_and_its_descendants_only(touch
 
 
 @pytest.mark.slow
+def test_discrepancy_target_runs_only_that_stage_and_what_it_needs(touched, tmp_path):
+    """Issue 9: `snakemake --cores 2 discrepancy` after an edit of the discrepancy code reruns that
+    stage alone; from an empty results folder it runs the stages it reads and none of the figure or
+    report jobs of the others."""
+    work, cfg = touched
+    module = work / "src" / "jointcal" / "discrepancy" / "select.py"
+    original = _edit(module)
+    try:
+        assert set(_jobs(_snakemake(work, "-n", "discrepancy", *cfg))) == {
+            "discrepancy_assembly", "discrepancy_table", "discrepancy"}
+    finally:
+        module.write_text(original)
+    fresh = ["--config", f"raw_data={SMALL_CAMPAIGN}", f"results={tmp_path / 'fresh'}"]
+    jobs = set(_jobs(_snakemake(work, "-n", "discrepancy", *fresh)))
+    assert {"ingest", "envelopes_run", "calibrate_assembly", "validate_assembly", "discrepancy_assembly",
+            "discrepancy_table"} <= jobs
+    assert not jobs & {"modal_figures", "calibration_figures", "posterior_corner", "validate_figures",
+                       "report_summary"}, jobs
+
+
+@pytest.mark.slow
 def test_typo_in_config_is_one_line_before_any_schema_dump(touched):
     work, cfg = touched
     res = _snakemake(work, "-n", *cfg, "calibrate={populaton: 40}")

@@ -9,7 +9,7 @@ included). Prints per case: named effect, confidence, E before and after, the fa
 joint parameters' mean |log error| against the truth before and after, the stage's wall
 time and the per-candidate times.
 
-    python tests/benchmarks/bench_discrepancy.py [--only NAME] [--out FILE]
+    python tests/benchmarks/bench_discrepancy.py [--only NAME] [--index 1,4] [--out FILE]
 
 Strengths: cubic k3 = 2e11 lbf/in^3 moves the 10 g resonance by ~0.6% (3/4 k3 q^2 / (2 k) with
 q ~ 3e-4 in, k ~ 1.2e6 lbf/in); quadratic c2 = 0.4 lbf s^2/in^2 adds 4 c2 q / (3 pi m) ~ 0.007 to
@@ -32,6 +32,7 @@ from jointcal.discrepancy import DiscrepancySettings, diagnose
 from jointcal.discrepancy.stage import valley_starts
 from jointcal.io import read_manifest, read_run, write_csv_atomic
 from jointcal.modal import measure_run, scatter
+from jointcal.models import harmonic_balance
 from jointcal.synth import generate
 
 JOINTS = [dict(Fs=240.0, KT=1.3e6, chi=-0.55, beta=0.01, k=6.0e5, zeta_v=0.002),
@@ -83,19 +84,34 @@ def run_case(i, name, params, tmp: Path):
     e0 = np.mean([abs(np.log(best[p] / joint[p])) for p in keys])
     e1 = np.mean([abs(np.log(after[p]["value"] / joint[p])) for p in keys])
     per = ", ".join(f"{c['name']} {c['seconds']:.0f}s" for c in d["candidates"])
+    each = " ".join(f"{p} {abs(np.log(best[p] / joint[p])):.2f}->{abs(np.log(after[p]['value'] / joint[p])):.2f}"
+                    for p in keys)
+    # what the envelopes identify: the joint's frequency and damping curves over the measured amplitudes
+    q = np.geomspace(table["q_in"].min(), table["q_in"].max(), 40)
+    m = float(best["m"])
+    curve = lambda p: harmonic_balance(q, *(p[k] for k in ("Fs", "KT", "chi", "beta", "k")), m, p["zeta_v"])  # noqa: E731
+    ft, zt = curve(joint)
+    errs = []
+    for p in (best, {k: v["value"] for k, v in after.items()}):
+        f, z = curve(p)
+        errs.append((np.max(np.abs(f / ft - 1)) * 100, np.max(np.abs(z / zt - 1)) * 100))
+    kk = " ".join(f"{lab} {abs(np.log(v(best) / v(joint))):.2f}->{abs(np.log(v({k: x['value'] for k, x in after.items()}) / v(joint))):.2f}"
+                  for lab, v in (("k+KT", lambda p: p["k"] + p["KT"]),))
+    curves = (f"curves vs truth: f {errs[0][0]:.3f}%->{errs[1][0]:.3f}%, zeta {errs[0][1]:.1f}%->{errs[1][1]:.1f}%, {kk}")
     return (f"{name:20s} {json.dumps(params):40s} -> {d['effect']:20s} {d['confidence']:6s} "
             f"E {d['metric_before']:6.2f} -> {d['metric_after']:5.2f} ({(d['metric_after'] / d['metric_before'] - 1) * 100:+4.0f}%) "
-            f"joint |log err| {e0:.2f} -> {e1:.2f}; stage {wall:.0f} s ({per})")
+            f"joint |log err| {e0:.2f} -> {e1:.2f} ({each}); {curves}; stage {wall:.0f} s ({per})")
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--only", default=None)
+    ap.add_argument("--index", default=None, help="comma-separated case numbers (0-based)")
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
     lines = []
     for i, (name, params) in enumerate(CASES):
-        if a.only and name != a.only:
+        if (a.only and name != a.only) or (a.index and str(i) not in a.index.split(",")):
             continue
         with tempfile.TemporaryDirectory() as d:
             line = run_case(i, name, params, Path(d))
