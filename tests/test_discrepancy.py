@@ -176,7 +176,8 @@ def test_end_to_end_hidden_gain_is_named_and_the_gap_shrinks(tmp_path):
     write_csv_atomic(scatter(table), tmp_path / "scatter.csv")
     cal, _ = run_calibration(tmp_path / "modal.csv", "a", tmp_path / "cal", CalibrateSettings())
     best = json.loads((tmp_path / "cal" / "ga_best.json").read_text())
-    s = DiscrepancySettings(candidates=("sensor_gain", "channel_delay", "fixture_flexibility"))
+    s = DiscrepancySettings(candidates=("sensor_gain", "channel_delay", "fixture_flexibility"), ga_generations=5,
+                            posterior_steps=300)
     starts = valley_starts(pd.read_csv(tmp_path / "cal" / "ga_history.csv"), best)
     out = diagnose("a", envs, table, best, None, records, rows, space=SPACE, settings=s, joint_starts=starts,
                    log=print)

@@ -154,6 +154,7 @@ def _calibrate_and_sample(args):
 
 
 @pytest.mark.slow
+@pytest.mark.acceptance
 def test_coverage_and_curves_across_campaigns(tmp_path):
     """(c) 90% intervals contain the truth for >= 80% of the (parameter, campaign) pairs the data
     constrain (posterior 90% width < half the prior width in the sampling space), over 5 campaigns

@@ -6,6 +6,7 @@ Oracles: an analytic FRF for a linear model; the truth that generated a syntheti
 from __future__ import annotations
 
 import json
+import re
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
@@ -139,16 +140,18 @@ def test_E_of_the_calibrated_model_is_at_the_noise_floor_and_grows_with_a_hidden
     between samples, before the band-limited reconstruction, 1e-3 and 1.8%). Measured: 2% noise: E true 0.53, calibrated 0.63;
     sensor_gain 1.15: 16.
     """
-    rows, records, best, truth = _campaign(tmp_path / "exact", {"name": "none"})
-    a = truth["assemblies"]["first"]
-    with ProcessPoolExecutor(max_workers=2) as ex:
+    noisy = {"noise_fraction": 0.02}
+    with ProcessPoolExecutor(max_workers=2) as ex:  # three independent campaigns, then their validations
+        made = list(ex.map(_campaign, [tmp_path / "exact", tmp_path / "none", tmp_path / "gain"],
+                           [{"name": "none"}, {"name": "none"}, {"name": "sensor_gain", "params": {"gain": 1.15}}],
+                           [None, noisy, noisy]))
+        rows, records, best, truth = made[0]
+        a = truth["assemblies"]["first"]
         v_exact = validate_runs([run_model(a, r["sequence"]) for r in rows], records, rows, executor=ex)
-        noisy = {"noise_fraction": 0.02}
-        rows, records, best, truth = _campaign(tmp_path / "none", {"name": "none"}, noisy)
+        rows, records, best, truth = made[1]
         e_true = validate_runs([run_model(a, r["sequence"]) for r in rows], records, rows, executor=ex).error["E"]
         e_cal = validate_runs(lambda r: model_from_best(best), records, rows, executor=ex).error["E"]
-        rows, records, best_g, _ = _campaign(tmp_path / "gain", {"name": "sensor_gain", "params": {"gain": 1.15}},
-                                             noisy)
+        rows, records, best_g, _ = made[2]
         v_gain = validate_runs(lambda r: model_from_best(best_g), records, rows, executor=ex)
     m = v_exact.metrics
     print(f"\nexact model at 0.3% noise: E {v_exact.error['E']:.2f}, max |f_res error| "
@@ -162,7 +165,8 @@ def test_E_of_the_calibrated_model_is_at_the_noise_floor_and_grows_with_a_hidden
 
 @pytest.mark.slow
 def test_workflow_validate_stage_reruns_only_itself_on_a_config_edit(tmp_path, small_campaign):
-    """`snakemake validate` on a copy of the small campaign; then -n: nothing; an edit of validate: only it."""
+    """`snakemake validate` on a copy of the small campaign; then -n: nothing; an edit of validate: only it.
+    Then `snakemake discrepancy` (light settings) runs that stage alone on top and writes its outputs."""
     import shutil
     import subprocess
     import sys
@@ -198,3 +202,16 @@ def test_workflow_validate_stage_reruns_only_itself_on_a_config_edit(tmp_path, s
     (work / "small.yaml").write_text(yaml.safe_dump(small))
     dry = smk("-n", "validate").stdout
     assert "validate_assembly" in dry and "calibrate_assembly" not in dry and "posterior_assembly" not in dry
+    small["validate"]["n_draws"] = 2
+    small["discrepancy"] = {"candidates": ["sensor_gain", "channel_delay"], "max_nfev": 8, "max_frames": 24,
+                            "ga_generations": 2, "posterior_steps": 100}
+    (work / "small.yaml").write_text(yaml.safe_dump(small))
+    res = smk("discrepancy")
+    assert res.returncode == 0, res.stderr
+    ran = set(re.findall(r"rule (\w+):", res.stdout + res.stderr))
+    assert ran == {"discrepancy_assembly", "discrepancy_table", "discrepancy"}, ran
+    d = json.loads((out / "discrepancy" / "first" / "diagnosis.json").read_text())
+    assert d["effect"] in {"sensor_gain", "channel_delay", "none", "unexplained"}
+    assert np.isfinite(d["metric_before"]) and np.isfinite(d["metric_after"]) and "emcee" in d["recalibrated"]["method"]
+    assert (out / "discrepancy" / "first" / "diagnosis.md").read_text().startswith("# Discrepancy diagnosis")
+    assert "<table>" in (out / "discrepancy" / "table_3_2_corrected.html").read_text()

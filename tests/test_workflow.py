@@ -67,6 +67,7 @@ def test_lint_reports_only_the_expected_conda_advice(workdir, small_campaign, tm
     assert set(items) == {"* Specify a conda environment or container for each rule.:"}, res.stdout + res.stderr
 
 
+@pytest.mark.acceptance
 def test_default_config_runs_on_the_example_campaign(workdir, tmp_path):
     """`snakemake --cores 2` with the default raw_data/ (linked into the copy) runs every stage."""
     (workdir / "raw_data").symlink_to(REPO / "raw_data")
