@@ -43,7 +43,7 @@ class Recalibration:
     fit : the polished least-squares `Fit` (theta in physical units, E over all runs);
     ga_best_E : E of the GA's best individual; ga_generations : generations run;
     q05, q50, q95 : posterior quantiles of each parameter (physical units, `names` order);
-    steps, tau_max, converged : the chain's length, its largest autocorrelation time
+    steps, walkers, tau_max, converged : the chain's length, its walkers, its largest autocorrelation time
     (steps) and whether the 50-tau rule was met; acceptance : mean acceptance fraction.
     """
 
@@ -55,6 +55,7 @@ class Recalibration:
     q50: NDArray[np.float64]
     q95: NDArray[np.float64]
     steps: int
+    walkers: int
     tau_max: float
     converged: bool
     acceptance: float
@@ -114,5 +115,5 @@ def recalibrate(c: Candidate, runs: Sequence[RunEnvelope], starts: Sequence[Fit]
     phys = c.to_physical(full(keep))
     q05, q50, q95 = np.quantile(phys, [0.05, 0.5, 0.95], axis=0)
     return Recalibration(space.names, best, float(np.sqrt(ga.best_value)), int(ga.generations), q05, q50, q95,
-                         int(len(ch.chain)), float(np.max(ch.tau)), bool(ch.converged),
+                         int(len(ch.chain)), int(walkers), float(np.max(ch.tau)), bool(ch.converged),
                          float(np.mean(ch.acceptance)))

@@ -213,7 +213,7 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
                                                         "interval_90": rec.interval(6 + i)}
                                                for i, p in enumerate(cf.effect_params)},
                          "method": (f"DEAP GA ({rec.ga_generations} generations, best E {rec.ga_best_E:.3g}) seeded "
-                                    f"with {len(fits)} least-squares fits, polished; emcee {rec.steps} steps x 32 "
+                                    f"with {len(fits)} least-squares fits, polished; emcee {rec.steps} steps x {rec.walkers} "
                                     f"walkers, max tau {rec.tau_max:.0f} steps"
                                     + ("" if rec.converged else " (short of 50 tau: intervals approximate)")
                                     + "; intervals are the 5-95% posterior quantiles"),

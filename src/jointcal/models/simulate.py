@@ -21,7 +21,7 @@ from ._masing import kernel_constants
 from .iwan import derived
 from .structure import MinistackModel, state_space
 
-__all__ = ["SimResult", "simulate", "hermite_propagator", "fractional_delay", "substeps", "reconstruction_factor"]
+__all__ = ["SimResult", "simulate", "hermite_propagator", "fractional_delay", "substeps", "band_limited"]
 
 
 @dataclass(frozen=True)
@@ -100,16 +100,19 @@ def fractional_delay(x: ArrayLike, tau: float, fs: float) -> NDArray[np.float64]
     return np.fft.irfft(X * np.exp(-2j * np.pi * f * tau), nfft)[:n]
 
 
-def reconstruction_factor(model: MinistackModel, fs: float, samples_per_cycle: float = 12.0) -> int:
-    """Upsampling factor U so that the input has `samples_per_cycle` samples per cycle at f0.
+def band_limited(u: NDArray, fs: float, f_hz: float, samples_per_cycle: float = 12.0) -> tuple[NDArray, int]:
+    """A sampled input reconstructed between its samples as the band-limited signal it is.
 
+    Returns (u_up, U): the record resampled by the integer factor U that gives at least
+    `samples_per_cycle` samples per cycle at `f_hz` (polyphase, Kaiser-windowed sinc:
+    `scipy.signal.resample_poly`, zero phase, so sample k*U is input sample k), and U.
     A record sampled at a few samples per cycle (2.5 kHz at 10 kHz: 4) is band limited
     (anti-aliased) but not smooth between samples: the step's cubic Hermite through its
     values and finite-difference rates misses it by percents (measured: the exact model
-    driven by a 10 kHz record read 0.2 dB low and 0.07% stiff at 2.4 kHz). Polyphase
-    (Kaiser-windowed sinc) resampling by U reconstructs it as the band-limited signal it is.
+    driven by a 10 kHz record read 0.2 dB low and 0.07% stiff at 2.4 kHz).
     """
-    return max(1, int(np.ceil(samples_per_cycle * model.f0_hz / fs)))
+    U = max(1, int(np.ceil(samples_per_cycle * f_hz / fs)))
+    return (resample_poly(u, U, 1) if U > 1 else u), U
 
 
 def simulate(model: MinistackModel, base_accel_g: ArrayLike, fs: float, *,
@@ -139,7 +142,7 @@ def simulate(model: MinistackModel, base_accel_g: ArrayLike, fs: float, *,
     samples_per_cycle : float or None
         The record is treated as band limited and reconstructed between samples by
         polyphase resampling (`scipy.signal.resample_poly`) until it has at least this
-        many samples per cycle of the stuck-joint frequency (`reconstruction_factor`);
+        many samples per cycle of the stuck-joint frequency (`band_limited`);
         the substeps then divide the reconstructed interval. None: the cubic Hermite
         through the samples (exact for inputs that are cubic between samples).
 
@@ -157,10 +160,10 @@ def simulate(model: MinistackModel, base_accel_g: ArrayLike, fs: float, *,
         raise ValueError("simulate: base_accel_g holds NaN or inf; clean or trim the record first.")
     if not fs > 0:
         raise ValueError(f"simulate: sample rate must be positive, got {fs!r}.")
-    U = 1 if samples_per_cycle is None else reconstruction_factor(model, fs, samples_per_cycle)
     n_out = u.size
-    if U > 1:
-        u = resample_poly(u, U, 1)  # zero-phase: sample k*U is input sample k
+    U = 1
+    if samples_per_cycle is not None:
+        u, U = band_limited(u, fs, model.f0_hz, samples_per_cycle)
         fs = fs * U
     n_sub = substeps(model, fs, omega_h) if n_sub is None else int(n_sub)
     ss = state_space(model)

@@ -30,14 +30,13 @@ from __future__ import annotations
 from dataclasses import dataclass, fields
 
 import numpy as np
-from scipy.signal import resample_poly
 from numpy.typing import NDArray
 
 from ..models import G, MinistackModel, harmonic_balance
 from ..models import _integrator
 from ..models._masing import kernel_constants
 from ..models.iwan import derived
-from ..models.simulate import _substep_maps, fractional_delay, hermite_propagator
+from ..models.simulate import _substep_maps, band_limited, fractional_delay, hermite_propagator
 
 __all__ = ["Shaker", "BL_E_PER_BL", "rig_matrices", "simulate_rig", "structure_equivalent", "rig_pole",
            "steady_amplitude", "structure_resonance_amplitude", "rig_truth"]
@@ -142,10 +141,8 @@ def simulate_rig(model: MinistackModel, shaker: Shaker, volts: NDArray, fs: floa
     A, bu, bf, outs = rig_matrices(model, shaker)
     ks, _, m = _structure(model)
     w0 = np.sqrt((ks + shaker.k_s) / (m + shaker.m_a))
-    U = max(1, int(np.ceil(12.0 * w0 / (2 * np.pi * fs))))  # band-limited input, as `simulate` does
-    if U > 1:
-        u = resample_poly(u, U, 1)
-        fs = fs * U
+    u, U = band_limited(u, fs, w0 / (2 * np.pi))  # as `simulate` reads its input
+    fs = fs * U
     n_sub = max(1, int(np.ceil(w0 / (omega_h * fs))))
     H = 1.0 / fs
     h = H / n_sub
