@@ -15,6 +15,8 @@ What a lab's FRF software does with a swept-sine or chirp record:
   within n_band / T Hz (T the record length): over a short chirp the coherence dips at
   a sharp peak without any noise (measured: 0.83 at a zeta = 1.5%, 100 Hz peak over a
   4 s record; > 0.99 over a 90 s one).
+* ``pair_backbone``: a voltage reference's bent peak, pole by pole over the amplitudes the
+  peak region spans (see below).
 * ``fit_mode``: resonance and damping from a single-degree-of-freedom rational fit
   of the peak region of the displacement ratio (receptance, or relative displacement
   over base acceleration), with residual terms for the modes outside the band:
@@ -32,7 +34,9 @@ had, i.e. the equivalent-linear (harmonic-balance) frequency at the run's level 
 slow sweep (measured within 0.2% on the Table 3.2 joint up to eta ~5). The fitted pole
 and damping of a bent peak are not that (off by up to ~1% and tens of % on that joint;
 the fit residual shows it, flag 'frf_misfit' in `jointcal.modal`); a voltage reference
-has only the pole. A fast chirp never builds the steady-state amplitude, so it shows the
+has only the pole, and its bent peak is read by ``pair_backbone``: lines of equal |X| below and
+above the peak see the same frozen FRF, and each pair gives its pole without the modal constant
+(``backbone_at_peak``: at the peak's amplitude). A fast chirp never builds the steady-state amplitude, so it shows the
 structure at a smaller one.
 
 Reference kinds (`jointcal._contract.REFERENCE`): base acceleration (g; the ratio is
@@ -50,11 +54,12 @@ import pandas as pd
 from numpy.typing import NDArray
 from scipy import signal
 from scipy.ndimage import uniform_filter1d
-from scipy.optimize import least_squares
+from scipy.optimize import brentq, least_squares
 
 from .models import G
 
-__all__ = ["ModeFit", "h1_estimate", "zeta_at_quadrature", "displacement_ratio", "fit_mode", "record_frf", "frf_table"]
+__all__ = ["ModeFit", "h1_estimate", "zeta_at_quadrature", "displacement_ratio", "fit_mode", "pair_backbone",
+           "backbone_at_peak", "record_frf", "frf_table"]
 
 
 @dataclass(frozen=True)
@@ -257,6 +262,95 @@ def zeta_at_quadrature(fit: ModeFit) -> float:
     the energy-balance damping at the peak's amplitude.
     """
     return float(1.0 / (2.0 * (2 * np.pi * fit.f_quad_hz) ** 2 * fit.x_quad))
+
+
+def pair_backbone(f: NDArray, X: NDArray, levels: NDArray = np.linspace(0.5, 0.9, 17), *,
+                  f_guess: float | None = None, near_frac: float = 0.1) -> pd.DataFrame:
+    """Equivalent-linear frequency and damping at several amplitudes, from equal-amplitude line pairs.
+
+    For a drive of constant amplitude (an amplifier's voltage) each line of a quasi-steady
+    sweep's ratio X = x / ref is the equivalent-linear (first-harmonic) FRF frozen at the
+    amplitude q the structure had there, and q is proportional to |X|. At a level s of the
+    peak, the line w_1 below and w_2 above the peak with |X| = s |X|_peak see the SAME frozen
+    FRF A / (Omega^2 - w^2 + i D w), so
+
+        Omega^2 = (w_1^2 + w_2^2 + D^2) / 2                      (|X(w_1)| = |X(w_2)|)
+        arg X(w_1) - arg X(w_2) = arg[(Omega^2 - w_2^2 + i D w_2) / (Omega^2 - w_1^2 + i D w_1)]
+
+    which give Omega and D at that amplitude without the modal constant A (its phase cancels:
+    an amplifier voltage's phase to the force is unknown). zeta = D / (2 Omega). For a linear
+    structure every level gives the same exact pole; for a softening joint Omega falls and zeta
+    grows towards the peak: the backbone over the amplitudes the peak region spans.
+
+    Parameters
+    ----------
+    f : ndarray, Hz;  X : complex ndarray
+        Displacement ratio on increasing lines (`displacement_ratio`), the peak region included.
+    levels : ndarray
+        Fractions s of the peak |X| (0 < s < 1) at which pairs are taken.
+    f_guess : float, optional
+        The largest |X| within f_guess (1 +- near_frac) (Hz) instead of the largest overall.
+
+    Returns
+    -------
+    DataFrame, one row per level resolved
+        level (s), f1_hz, f2_hz (the pair), f_hz (Omega / 2 pi), zeta. Levels whose pair
+        leaves the lines, or whose phase difference no damping reproduces, are left out.
+
+    Notes
+    -----
+    Assumes the modal constant constant across the pair and no other mode nearby (an
+    amplifier's coil inductance turns A by -(L/R) / (1 + (w L/R)^2) rad per rad/s: about 1% of
+    the phase difference on the synthetic Ministack rig), and quasi-steady lines: a sweep too
+    fast for the nonlinear structure to follow (eta above ~5) breaks the line-amplitude map.
+    """
+    ok = np.isfinite(X)
+    f, X = np.asarray(f, float)[ok], np.asarray(X)[ok]
+    a = np.abs(X)
+    near = np.ones(a.size, bool) if f_guess is None else np.abs(f / f_guess - 1) <= near_frac
+    ip = int(np.flatnonzero(near)[np.argmax(a[near])]) if near.any() else int(np.argmax(a))
+    s = a / a[ip]
+    ph = np.unwrap(np.angle(X))
+    rows = []
+    for lv in np.atleast_1d(levels):
+        lo, hi = np.flatnonzero(s[:ip] < lv), np.flatnonzero(s[ip:] < lv)
+        if not (lo.size and hi.size):
+            continue
+        i, j = lo[-1], ip + hi[0] - 1  # crossings between lines i, i+1 (rising) and j, j+1 (falling)
+        u, v = (lv - s[i]) / (s[i + 1] - s[i]), (lv - s[j]) / (s[j + 1] - s[j])
+        f1, f2 = f[i] + u * (f[i + 1] - f[i]), f[j] + v * (f[j + 1] - f[j])
+        dphi = (ph[i] + u * (ph[i + 1] - ph[i])) - (ph[j] + v * (ph[j + 1] - ph[j]))
+        w1, w2 = 2 * np.pi * f1, 2 * np.pi * f2
+
+        def gap(D):
+            o2 = 0.5 * (w1**2 + w2**2 + D**2)
+            return np.angle((o2 - w2**2 + 1j * D * w2) / (o2 - w1**2 + 1j * D * w1)) - dphi
+
+        lo_d, hi_d = 1e-6 * w1, 2.0 * w1
+        if not (w2 > w1 and gap(lo_d) * gap(hi_d) < 0):
+            continue
+        D = brentq(gap, lo_d, hi_d, xtol=1e-12 * w1)
+        om = np.sqrt(0.5 * (w1**2 + w2**2 + D**2))
+        rows.append(dict(level=float(lv), f1_hz=float(f1), f2_hz=float(f2), f_hz=float(om / (2 * np.pi)),
+                         zeta=float(D / (2 * om))))
+    return pd.DataFrame(rows, columns=["level", "f1_hz", "f2_hz", "f_hz", "zeta"])
+
+
+def backbone_at_peak(bb: pd.DataFrame, *, min_levels: int = 5) -> tuple[float, float, float]:
+    """The pair backbone extrapolated to the peak's amplitude (s = 1): frequency (Hz), zeta, spread.
+
+    A straight line in s through the levels (least squares), evaluated at s = 1: the
+    equivalent-linear pole at the amplitude of the peak, i.e. at the run's steady-state
+    level for a slow sweep. spread: the RMS relative misfit of that line to the levels'
+    frequencies (how far the backbone is from straight over 0.5-0.9 of the peak).
+    NaNs when fewer than `min_levels` levels were resolved.
+    """
+    if len(bb) < min_levels:
+        return float("nan"), float("nan"), float("nan")
+    s = bb["level"].to_numpy()
+    cf, cz = np.polyfit(s, bb["f_hz"], 1), np.polyfit(s, bb["zeta"], 1)
+    spread = float(np.sqrt(np.mean((np.polyval(cf, s) / bb["f_hz"].to_numpy() - 1) ** 2)))
+    return float(np.polyval(cf, 1.0)), float(np.polyval(cz, 1.0)), spread
 
 
 MODAL_PHASE = {"base": np.pi, "force": 0.0, "voltage": None}  # phase of the modal constant, rad

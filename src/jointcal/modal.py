@@ -16,7 +16,10 @@ From a run's envelopes (`jointcal.signal.envelopes`):
   and damping of the whole-record H1's single-mode fit ('frf_fit'), as a lab's FRF
   software reads them; for a nonlinear structure the equivalent FRF at that drive
   level. Reported for every run with a record (f_frf_hz, zeta_frf, frf_residual), so
-  the envelope and FRF read-outs can be compared.
+  the envelope and FRF read-outs can be compared. A voltage reference's modal constant
+  has an unknown phase, and a nonlinear joint bends the peak: its resonance and damping
+  are read from equal-amplitude line pairs, the equivalent-linear pole at the peak's
+  amplitude ('frf_backbone', f_backbone_hz, zeta_backbone; `jointcal.frf.pair_backbone`).
 * the peak of the response envelope (the paper's resonance read-out);
 * damping by half-power bandwidth of the response envelope (the paper's estimate),
   and by phase-resonance energy balance at quadrature, zeta = |a_base| / (2 omega^2 q)
@@ -32,7 +35,7 @@ import numpy as np
 import pandas as pd
 
 from ._contract import LEVEL, REFERENCE, RESPONSE
-from .frf import record_frf, zeta_at_quadrature
+from .frf import backbone_at_peak, pair_backbone, record_frf, zeta_at_quadrature
 from .models import G
 from .signal import envelopes
 
@@ -128,7 +131,8 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
         One row of modal_properties.csv. ``f_res_hz`` by ``f_res_method``:
         'quadrature' / 'quadrature_slope' (base- and force-driven envelopes, lag-corrected;
         see the module docstring), 'frf_fit' (the whole-record H1's single-mode fit:
-        force- and voltage-driven runs, and base-driven runs beyond eta_frf), 'peak'
+        force-driven runs, and base-driven runs beyond eta_frf), 'frf_backbone' (voltage-driven
+        runs: the pair backbone at the peak's amplitude, damping ``zeta_backbone``), 'peak'
         (envelope peak, no quadrature and no FRF). Always alongside: ``f_peak_hz``
         (envelope peak), ``f_frf_hz`` and ``zeta_frf`` (the FRF fit's pole: for a nonlinear
         structure the equivalent FRF at that drive level, see `jointcal.frf`),
@@ -149,14 +153,23 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
             lo + 0.02 * (hi - lo) < fit.f_n_hz < hi - 0.02 * (hi - lo))):
         flags.append("resonance_outside_band")  # a peak at the band's edge is no mode: no FRF read-out
         fit = None
+    f_bb = z_bb = np.nan
+    if fit is not None and kind == "voltage":  # the modal constant's phase is unknown: equal-amplitude pairs
+        f_bb, z_bb, _ = backbone_at_peak(pair_backbone(tab["freq_hz"].to_numpy(),
+                                                       (tab["x_re"] + 1j * tab["x_im"]).to_numpy(),
+                                                       f_guess=fit.f_n_hz, near_frac=3 * fit.zeta))
+        if not (np.isfinite(f_bb) and abs(f_bb / fit.f_n_hz - 1) <= 3 * fit.zeta and 0 < z_bb < 0.5):
+            f_bb = z_bb = np.nan  # not this mode's peak (or too few levels resolved)
     if fit is not None:
-        eta_frf_fit = rate_hz_per_s / (fit.f_n_hz * fit.zeta) ** 2
+        eta_frf_fit = rate_hz_per_s / (fit.f_n_hz * (z_bb if np.isfinite(z_bb) else fit.zeta)) ** 2
         eta = eta if np.isfinite(eta) and kind == "base" else eta_frf_fit  # a force's zeta needs the mass
         if kind != "base" or eta > eta_frf or method in ("peak", "none"):
             # the quadrature of the measured ratio where it belongs to this mode (within the
             # half-power half-width of the pole; a sensor off the driving point may have none)
             quad = np.isfinite(fit.f_quad_hz) and abs(fit.f_quad_hz - fit.f_n_hz) <= fit.zeta * fit.f_n_hz
             f_res, method = (fit.f_quad_hz if quad else fit.f_n_hz), "frf_fit"
+            if np.isfinite(f_bb):  # a voltage: the backbone at the peak's amplitude, bent peaks included
+                f_res, method = f_bb, "frf_backbone"
             flags = [f for f in flags if f != "no_quadrature"]
             # energy balance at the FRF's quadrature where the modal constant is known: -G in/g
             # for z / a_base, G / mass_lbf in/lbf (1/m) for x / F; none for a voltage
@@ -173,7 +186,7 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
         flags.append("unusable")
     out.update(env_out, f_res_hz=float(f_res), f_res_method=method, eta=float(eta),
                f_frf_hz=fit.f_n_hz if fit else np.nan, f_frf_quad_hz=fit.f_quad_hz if fit else np.nan,
-               zeta_frf=fit.zeta if fit else np.nan,
+               zeta_frf=fit.zeta if fit else np.nan, f_backbone_hz=float(f_bb), zeta_backbone=float(z_bb),
                frf_residual=fit.residual if fit else np.nan, frf_truncated=fit.truncated if fit else np.nan,
                flags=";".join(dict.fromkeys(flags)))
     return (out, tab) if with_frf else out
