@@ -104,7 +104,7 @@ def test_response_in_m_s2_gives_the_same_modal_table(tmp_path):
             assert pb[key] == pytest.approx(v, rel=1e-8), key
         else:
             assert pb[key] == v or (v != v and pb[key] != pb[key]), key
-    assert pa["f_res_method"] == "frf_fit"
+    assert pa["f_res_method"] == "sweep_fit" and pa["zeta_sweep"] == pytest.approx(ZETA, rel=0.01)
     assert pa["f_res_hz"] == pytest.approx(F0, rel=5e-4) and pa["zeta_frf"] == pytest.approx(ZETA, rel=0.01)
 
 

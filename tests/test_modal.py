@@ -193,13 +193,18 @@ def test_force_driven_driving_point(tmp_path):
     env, meta = envelopes(df, runs.iloc[0].to_dict())
     out = modal_properties(env, runs.iloc[0].to_dict(), rate_hz_per_s=meta.rate_hz_per_s, record=df)
     p = model.iwan
-    f, z = harmonic_balance(out["q_in"], p.Fs, p.KT, p.chi, p.beta, model.k, model.m, model.zeta_v)
+    f, z = harmonic_balance(out["q_envelope_in"], p.Fs, p.KT, p.chi, p.beta, model.k, model.m, model.zeta_v)
+    f_s, z_s = harmonic_balance(out["q_in"], p.Fs, p.KT, p.chi, p.beta, model.k, model.m, model.zeta_v)
     assert "level_lbf" in out and "level_g" not in out
-    # force reference: the H1's quadrature; the joint bends the constant-force peak (fit residual
-    # above 2%: flagged), which moves the fitted pole but not the quadrature
-    print(f"\nfit residual {out['frf_residual']:.3f}, f_frf {out['f_frf_hz']:.1f} Hz, f_res {out['f_res_hz']:.1f} Hz")
-    assert out["f_res_method"] == "frf_fit" and out["flags"] == "frf_misfit"
-    assert out["f_res_hz"] == pytest.approx(float(f), rel=3e-4)
+    # force reference: the swept-mode fit at the amplitude reached (q_in); beside it the H1's quadrature at
+    # the envelopes' amplitude there. The joint bends the constant-force peak (fit residual above 2%:
+    # flagged), which moves the fitted pole but neither of those
+    print(f"\nfit residual {out['frf_residual']:.3f}, f_frf {out['f_frf_hz']:.1f} Hz, quadrature "
+          f"{out['f_frf_quad_hz']:.1f} Hz, sweep fit {out['f_res_hz']:.1f} Hz at {out['q_in']:.2e} in")
+    assert out["f_res_method"] == "sweep_fit" and out["flags"] == "frf_misfit"
+    assert out["f_res_hz"] == pytest.approx(float(f_s), rel=1e-3)
+    assert out["zeta_sweep"] == pytest.approx(float(z_s), rel=0.05)
+    assert out["f_frf_quad_hz"] == pytest.approx(float(f), rel=3e-4)
     assert out["zeta_phase_resonance"] == pytest.approx(float(z), rel=0.02)
     assert env["drive_on"].iloc[-20:].eq(False).all()  # the free decay is not taken for drive
 

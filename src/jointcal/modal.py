@@ -20,6 +20,14 @@ From a run's envelopes (`jointcal.signal.envelopes`):
   has an unknown phase, and a nonlinear joint bends the peak: its resonance and damping
   are read from equal-amplitude line pairs, the equivalent-linear pole at the peak's
   amplitude ('frf_backbone', f_backbone_hz, zeta_backbone; `jointcal.frf.pair_backbone`).
+  Both need quasi-steady lines; a chirp faster than the joint can follow breaks them. So for
+  force- and voltage-driven runs the resonance is finally read from the whole transient:
+  one mode with amplitude-dependent frequency and damping driven by the measured reference,
+  fitted to the response (`jointcal.sweepfit`, method 'sweep_fit'; f_sweep_hz, zeta_sweep,
+  sweep_residual), at the largest amplitude the run reached, which becomes q_in (the
+  envelopes' own amplitude stays in q_envelope_in). Kept only when it is this mode (within
+  10% of the FRF read-out, envelope misfit <= 0.1; e.g. a sensor off the driving point,
+  whose mass line no single mode holds, keeps 'frf_fit').
 * the peak of the response envelope (the paper's resonance read-out);
 * damping by half-power bandwidth of the response envelope (the paper's estimate),
   and by phase-resonance energy balance at quadrature, zeta = |a_base| / (2 omega^2 q)
@@ -38,6 +46,7 @@ from ._contract import LEVEL, REFERENCE, RESPONSE
 from .frf import backbone_at_peak, pair_backbone, record_frf, zeta_at_quadrature
 from .models import G
 from .signal import envelopes
+from .sweepfit import fit_swept_mode
 
 __all__ = ["modal_properties", "measure_run", "scatter", "FLAG_WORDS", "ENVELOPE_COLUMNS"]
 
@@ -132,7 +141,8 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
         'quadrature' / 'quadrature_slope' (base- and force-driven envelopes, lag-corrected;
         see the module docstring), 'frf_fit' (the whole-record H1's single-mode fit:
         force-driven runs, and base-driven runs beyond eta_frf), 'frf_backbone' (voltage-driven
-        runs: the pair backbone at the peak's amplitude, damping ``zeta_backbone``), 'peak'
+        runs: the pair backbone at the peak's amplitude, damping ``zeta_backbone``), 'sweep_fit'
+        (force and voltage runs: the swept-mode fit at q_in, damping ``zeta_sweep``), 'peak'
         (envelope peak, no quadrature and no FRF). Always alongside: ``f_peak_hz``
         (envelope peak), ``f_frf_hz`` and ``zeta_frf`` (the FRF fit's pole: for a nonlinear
         structure the equivalent FRF at that drive level, see `jointcal.frf`),
@@ -180,6 +190,10 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
                 flags.append("frf_truncated")
             if fit.residual > frf_misfit:
                 flags.append("frf_misfit")
+    sweep = _sweep_estimate(record, row, kind, f_res, method, fit, z_bb, env_out["zeta_phase_resonance"])
+    env_out["q_envelope_in"] = env_out["q_in"]  # the envelopes' amplitude at the crossing (or peak)
+    if sweep is not None:  # the whole transient, at the amplitude it reached (q_in goes with f_res_hz)
+        f_res, method, env_out["q_in"] = sweep.f_hz, "sweep_fit", sweep.q_in
     if np.isfinite(eta) and eta > eta_max:
         flags.append("eta_high")
     if method == "none" or (method == "peak" and "resonance_outside_band" in flags):
@@ -187,9 +201,30 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
     out.update(env_out, f_res_hz=float(f_res), f_res_method=method, eta=float(eta),
                f_frf_hz=fit.f_n_hz if fit else np.nan, f_frf_quad_hz=fit.f_quad_hz if fit else np.nan,
                zeta_frf=fit.zeta if fit else np.nan, f_backbone_hz=float(f_bb), zeta_backbone=float(z_bb),
+               f_sweep_hz=sweep.f_hz if sweep else np.nan, zeta_sweep=sweep.zeta if sweep else np.nan,
+               sweep_residual=sweep.residual if sweep else np.nan,
                frf_residual=fit.residual if fit else np.nan, frf_truncated=fit.truncated if fit else np.nan,
                flags=";".join(dict.fromkeys(flags)))
     return (out, tab) if with_frf else out
+
+
+def _sweep_estimate(record, row, kind, f_res, method, fit, z_bb, z_pr, max_residual=0.1):
+    """The swept-mode fit (`jointcal.sweepfit`) of a force- or voltage-driven run, started from its FRF
+    read-out; None for base-driven runs, without a record or FRF read-out, or when the fit is not this
+    mode (moved by more than 10%, or its envelope misfit above max_residual)."""
+    if kind == "base" or record is None or fit is None or method not in ("frf_fit", "frf_backbone"):
+        return None
+    z0 = next((z for z in (z_bb, z_pr, fit.zeta) if np.isfinite(z) and 0 < z < 0.5), None)
+    if z0 is None or not np.isfinite(f_res):
+        return None
+    try:
+        sw = fit_swept_mode(record[REFERENCE[kind]].to_numpy(float), record[RESPONSE].to_numpy(float),
+                            float(row["sample_rate_hz"]), float(f_res), float(z0))
+    except (ValueError, np.linalg.LinAlgError):
+        return None
+    ok = (np.isfinite(sw.f_hz) and abs(sw.f_hz / f_res - 1) < 0.1 and 0 < sw.zeta < 0.5
+          and sw.residual <= max_residual)
+    return sw if ok else None
 
 
 def _frf_estimates(record, row, kind, f_guess, span):
@@ -287,7 +322,7 @@ def _envelope_estimates(env, row, kind, rate_hz_per_s, mass_lbf, eta_max, snr_mi
     else:
         zeta_pr = a_ref * G / (2 * omega**2 * q) if method.startswith("quadrature") else np.nan
     zeta_eta = zeta_pr if np.isfinite(zeta_pr) else zeta_hp
-    eta = rate_hz_per_s / (f_res * zeta_eta) ** 2 if np.isfinite(zeta_eta) else np.nan
+    eta = rate_hz_per_s / (f_res * zeta_eta) ** 2 if np.isfinite(zeta_eta) and zeta_eta > 0 else np.nan
     if edge and kind == "base":  # an open-loop reference drops out at resonance: the FRF fit checks instead
         flags.append("resonance_outside_band")
     noise = float(np.median(e["noise_g"]))
