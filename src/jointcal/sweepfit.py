@@ -178,6 +178,13 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
     step = max(1, int(fs / (steps_per_cycle * f0)))
     R, Acc, w = R[::step], Acc[::step], w[::step]
     h = step / fs
+    sub = int(np.ceil(steps_per_cycle * f0 * h))  # a record sampled under 6 per cycle: finer steps on the
+    if sub > 1:                                   # envelopes (smooth below 0.45 f0), interpolated
+        t = np.arange(R.size) * h
+        tt = np.arange((R.size - 1) * sub + 1) * (h / sub)
+        R, Acc, w = (np.interp(tt, t, x.real) + 1j * np.interp(tt, t, x.imag) if np.iscomplexobj(x)
+                     else np.interp(tt, t, x) for x in (R, Acc, w))
+        h = h / sub
     dw = np.gradient(w, h)
     mag = np.abs(Acc)
     sel = mag > window * mag.max()
