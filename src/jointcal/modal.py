@@ -194,6 +194,7 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
     env_out["q_envelope_in"] = env_out["q_in"]  # the envelopes' amplitude at the crossing (or peak)
     if sweep is not None:  # the whole transient, at the amplitude it reached (q_in goes with f_res_hz)
         f_res, method, env_out["q_in"] = sweep.f_hz, "sweep_fit", sweep.q_in
+        eta = rate_hz_per_s / (sweep.f_hz * sweep.zeta) ** 2  # with the damping that fits the transient
     if np.isfinite(eta) and eta > eta_max:
         flags.append("eta_high")
     if method == "none" or (method == "peak" and "resonance_outside_band" in flags):
