@@ -220,7 +220,8 @@ def _sweep_estimate(record, row, kind, f_res, method, fit, z_bb, z_pr, max_resid
         return None
     try:
         sw = fit_swept_mode(record[REFERENCE[kind]].to_numpy(float), record[RESPONSE].to_numpy(float),
-                            float(row["sample_rate_hz"]), float(f_res), float(z0))
+                            float(row["sample_rate_hz"]), float(f_res), float(z0),
+                            modal_phase=0.0 if kind == "force" else None)
     except (ValueError, np.linalg.LinAlgError):
         return None
     ok = (np.isfinite(sw.f_hz) and abs(sw.f_hz / f_res - 1) < 0.1 and 0 < sw.zeta < 0.5

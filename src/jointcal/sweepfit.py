@@ -13,7 +13,7 @@ with x_a, r_a the analytic (Hilbert) signals of the displacement and the referen
 D = 2 zeta Omega shared between a viscous part and a hysteretic part phi (a joint's
 friction: its loss per cycle does not grow with frequency; phi matters where the data lie
 off Omega, e.g. a force-driven rig's response peaks at the shaker-loaded resonance), and
-A a complex modal constant (a force's is 1/m; an amplifier voltage's carries the shaker's
+A a complex modal constant, linear in the drive frequency, A = A_0 + A_1 (w / Omega_0 - 1) (a force's is 1/m; an amplifier voltage's carries the shaker's
 electrical phase). In a frame rotating with the drive, x_a = Z e^{i theta}, w = theta',
 this is exactly
 
@@ -85,16 +85,17 @@ def _rhs(z, y, r, w, dw, p, q_ref):
     w2 = p[0] * (1.0 + p[2] * s + p[3] * s * s)
     d = p[1] * (1.0 + p[4] * s + p[5] * s * s)  # 2 zeta Omega at q
     c = (1.0 - p[8]) * d  # the viscous share; the hysteretic share p[8] d Omega does not scale with w
-    return (p[6] + 1j * p[7]) * r - (2j * w + c) * y - (w2 - w * w + 1j * (c * w + p[8] * d * np.sqrt(w2) + dw)) * z
+    a = (p[6] + 1j * p[7]) + (p[9] + 1j * p[10]) * (w / p[11] - 1.0)  # the modal constant, sloped in w
+    return a * r - (2j * w + c) * y - (w2 - w * w + 1j * (c * w + p[8] * d * np.sqrt(w2) + dw)) * z
 
 
 @numba.njit(cache=True)
-def _rotating_mode(r, w, dw, h, p, q_ref):
-    """RK4 of the rotating-frame mode from rest; returns Z (in) and its acceleration envelope (in/s^2)."""
+def _rotating_mode(r, w, dw, h, p, q_ref, z0):
+    """RK4 of the rotating-frame mode from Z = z0, Z' = 0; returns Z (in) and its acceleration envelope (in/s^2)."""
     n = r.size
     Z = np.empty(n, np.complex128)
     acc = np.empty(n, np.complex128)
-    z, y = 0j, 0j
+    z, y = z0 + 0j, 0j
     for k in range(n):
         a1 = _rhs(z, y, r[k], w[k], dw[k], p, q_ref)
         Z[k] = z
@@ -136,7 +137,8 @@ def _lowpass(x: NDArray, fs: float, fc: float) -> NDArray:
 
 
 def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: float, *,
-                   window: float = 0.15, steps_per_cycle: float = 6.0) -> SweepFit:
+                   modal_phase: float | None = None, window: float = 0.15,
+                   steps_per_cycle: float = 6.0) -> SweepFit:
     """Fit one amplitude-dependent mode to a swept run (see the module docstring).
 
     Parameters
@@ -149,12 +151,16 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
         Sample rate, Hz.
     f0, zeta0 : float
         Start values: the resonance (Hz) and damping ratio from the FRF read-out.
+    modal_phase : float, optional
+        The modal constant's phase where physics fixes it (rad): 0 for a force on the
+        structure (A = 1/m, no frequency dependence). None (an amplifier voltage): A complex
+        and sloped in w.
     window : float
         Samples whose response envelope exceeds this fraction of its peak are fitted
         (the passage through resonance and the ring-down).
     steps_per_cycle : float
-        RK4 steps per period at f0 (the rotating frame's fast root bounds it: 6 keeps
-        |lambda| h < 2.1).
+        RK4 steps per period at f0, about (the rotating frame's fast root -(Omega + w)
+        bounds it: 6 keeps |lambda| h near 2.1, under RK4's 2.8).
 
     Returns
     -------
@@ -175,7 +181,7 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
     fc = 0.45 * f0  # the frame's envelopes: keeps |Omega - w| up to 0.45 f0, drops 2w and the harmonics
     R = _lowpass(signal.hilbert(r) * rot, fs, fc)
     Acc = _lowpass(signal.hilbert(a) * rot, fs, fc)
-    step = max(1, int(fs / (steps_per_cycle * f0)))
+    step = max(1, int(round(fs / (steps_per_cycle * f0))))
     R, Acc, w = R[::step], Acc[::step], w[::step]
     h = step / fs
     sub = int(np.ceil(steps_per_cycle * f0 * h))  # a record sampled under 6 per cycle: finer steps on the
@@ -187,7 +193,14 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
         h = h / sub
     dw = np.gradient(w, h)
     mag = np.abs(Acc)
+    sel = np.flatnonzero(mag > window * mag.max())
+    # integrate from where the response is under 5% of its peak before the fitted window (its measured
+    # state there, a forced response: Z = -Acc / w^2, Z' = 0; the small start error decays) to its end
+    quiet = np.flatnonzero(mag[:sel[0]] < 0.05 * mag.max())
+    i0 = int(quiet[-1]) if quiet.size else 0
+    R, Acc, w, dw, mag = (x[i0:sel[-1] + 1] for x in (R, Acc, w, dw, mag))
     sel = mag > window * mag.max()
+    z_start = complex(-Acc[0] / w[0] ** 2) if i0 > 0 else 0j
     ip = int(np.argmax(mag))
     q_ref = float(mag[ip] / w[ip] ** 2)
     W0 = 2 * np.pi * f0
@@ -195,27 +208,37 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
     a0 = 1j * 2 * zeta0 * W0**2 * (-Acc[ip] / w[ip] ** 2) / R[ip] if abs(R[ip]) > 0 else 1.0 + 0j
     a_abs = abs(a0)
 
-    def params(p):
+    fixed = modal_phase is not None  # a force: A = |A| e^{i phase} (1/m, phase 0), no slope
+    free = np.array([0, 1, 2, 3, 4, 5, 6, 8] if fixed else list(range(11)))
+
+    def params(pf):
+        p = np.zeros(11)
+        p[free] = pf
+        a = p[6] * np.exp(1j * modal_phase) if fixed else p[6] + 1j * p[7]
         return np.array([W0**2 * np.exp(2 * p[0]), 2 * zeta0 * W0 * np.exp(p[1]), p[2], p[3], p[4], p[5],
-                         p[6] * a_abs, p[7] * a_abs, p[8]])
+                         a.real * a_abs, a.imag * a_abs, p[8], p[9] * a_abs, p[10] * a_abs, W0])
 
     def misfit(p):
         with np.errstate(all="ignore"):  # a trial step may diverge: a large misfit, not a warning
-            res = (_rotating_mode(R, w, dw, h, params(p), q_ref)[1] - Acc)[sel] / scale
+            res = (_rotating_mode(R, w, dw, h, params(p), q_ref, z_start)[1] - Acc)[sel] / scale
         res = np.where(np.isfinite(res) & (np.abs(res) < 1e3), res, 1e3)
         return np.concatenate([res.real, res.imag])
 
     best = None
     for dz in (0.0, np.log(0.5), np.log(2.0)):  # damping starts: the FRF's zeta of a bent peak can be far off
-        p0 = np.array([0.0, dz, 0.0, 0.0, 0.0, 0.0, a0.real / a_abs, a0.imag / a_abs, 0.5])
-        sol = least_squares(misfit, p0, x_scale=[1e-3, 0.1, 0.05, 0.05, 0.2, 0.2, 0.1, 0.1, 0.2],
-                            bounds=([-np.inf] * 8 + [0.0], [np.inf] * 8 + [1.0]))
+        a_start = (a0 * np.exp(-1j * modal_phase)).real if fixed else a0.real
+        p0 = np.array([0.0, dz, 0.0, 0.0, 0.0, 0.0, a_start / a_abs, a0.imag / a_abs, 0.5, 0.0, 0.0])[free]
+        scale_x = np.array([1e-3, 0.1, 0.05, 0.05, 0.2, 0.2, 0.1, 0.1, 0.2, 0.5, 0.5])[free]
+        lo = np.array([-np.inf] * 8 + [0.0] + [-np.inf] * 2)[free]
+        hi = np.array([np.inf] * 8 + [1.0] + [np.inf] * 2)[free]
+        sol = least_squares(misfit, p0, x_scale=scale_x, bounds=(lo, hi), max_nfev=100)
         if best is None or sol.cost < best.cost:
             best = sol
-        if np.sqrt(2 * best.cost / sel.sum()) < 0.02:  # a good fit from the FRF's start: no more starts
+        rel = np.sqrt(2 * best.cost / sel.sum())
+        if rel < 0.02 or rel > 0.3:  # a good fit from the FRF's start, or no single mode: no more starts
             break
     p = params(best.x)
-    Z, _ = _rotating_mode(R, w, dw, h, p, q_ref)
+    Z, _ = _rotating_mode(R, w, dw, h, p, q_ref, z_start)
     q_top = float(np.abs(Z[sel]).max())
     q_low = float(np.abs(Z[sel]).min())
     coef = (*(float(v) for v in p[:6]), float(p[8]), q_ref)
