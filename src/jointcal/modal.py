@@ -216,7 +216,7 @@ def _sweep_estimate(record, row, kind, f_res, method, fit, z_bb, z_pr, max_resid
     (moved by more than 10%, or its envelope misfit above max_residual)."""
     if kind == "base" or record is None or fit is None or method not in ("frf_fit", "frf_backbone"):
         return None
-    if kind == "force" and not (np.isfinite(fit.f_quad_hz) and abs(fit.f_quad_hz / fit.f_n_hz - 1) <= fit.zeta):
+    if kind == "force" and not (np.isfinite(fit.f_quad_hz) and abs(fit.f_quad_hz / fit.f_n_hz - 1) <= 3 * fit.zeta):
         return None  # x / F never in quadrature at this mode: not a driving-point single mode (A = 1/m)
     z0 = next((z for z in (z_bb, z_pr, fit.zeta) if np.isfinite(z) and 0 < z < 0.5), None)
     if z0 is None or not np.isfinite(f_res):

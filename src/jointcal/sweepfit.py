@@ -235,7 +235,7 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
         if best is None or sol.cost < best.cost:
             best = sol
         rel = np.sqrt(2 * best.cost) / np.linalg.norm(Acc[sel] / scale)  # as SweepFit.residual
-        if rel < 0.02 or rel > 0.3:  # a good fit from the FRF's start, or no single mode: no more starts
+        if rel < 0.02:  # a good fit from the FRF's start: no more starts
             break
     p = params(best.x)
     Z, _ = _rotating_mode(R, w, dw, h, p, q_ref, z_start)
