@@ -224,26 +224,23 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
         res = np.where(np.isfinite(res) & (np.abs(res) < 1e3), res, 1e3)
         return np.concatenate([res.real, res.imag])
 
-    best = None
+    a_start = (a0 * np.exp(-1j * modal_phase)).real if fixed else a0.real
+    scale_x = np.array([1e-3, 0.1, 0.05, 0.05, 0.2, 0.2, 0.1, 0.1, 0.2, 0.5, 0.5])[free]
+    bounds = (np.array([-np.inf] * 8 + [0.0] + [-np.inf] * 2)[free], np.array([np.inf] * 8 + [1.0] + [np.inf] * 2)[free])
+    norm = np.linalg.norm(Acc[sel] / scale)
+    best, rel = None, np.inf
     for dz in (0.0, np.log(0.5), np.log(2.0)):  # damping starts: the FRF's zeta of a bent peak can be far off
-        a_start = (a0 * np.exp(-1j * modal_phase)).real if fixed else a0.real
         p0 = np.array([0.0, dz, 0.0, 0.0, 0.0, 0.0, a_start / a_abs, a0.imag / a_abs, 0.5, 0.0, 0.0])[free]
-        scale_x = np.array([1e-3, 0.1, 0.05, 0.05, 0.2, 0.2, 0.1, 0.1, 0.2, 0.5, 0.5])[free]
-        lo = np.array([-np.inf] * 8 + [0.0] + [-np.inf] * 2)[free]
-        hi = np.array([np.inf] * 8 + [1.0] + [np.inf] * 2)[free]
-        sol = least_squares(misfit, p0, x_scale=scale_x, bounds=(lo, hi), max_nfev=100)
+        sol = least_squares(misfit, p0, x_scale=scale_x, bounds=bounds, max_nfev=100)
         if best is None or sol.cost < best.cost:
-            best = sol
-        rel = np.sqrt(2 * best.cost) / np.linalg.norm(Acc[sel] / scale)  # as SweepFit.residual
+            best, rel = sol, float(np.linalg.norm(sol.fun) / norm)  # relative RMS misfit: SweepFit.residual
         if rel < 0.02:  # a good fit from the FRF's start: no more starts
             break
     p = params(best.x)
     Z, _ = _rotating_mode(R, w, dw, h, p, q_ref, z_start)
     q_top = float(np.abs(Z[sel]).max())
-    q_low = float(np.abs(Z[sel]).min())
     coef = (*(float(v) for v in p[:6]), float(p[8]), q_ref)
-    fit = SweepFit(f_hz=np.nan, zeta=np.nan, q_in=q_top, q_low_in=q_low,
-                   residual=float(np.linalg.norm(best.fun) / np.linalg.norm(np.concatenate(
-                       [Acc[sel].real, Acc[sel].imag]) / scale)), coef=coef)
+    fit = SweepFit(f_hz=np.nan, zeta=np.nan, q_in=q_top, q_low_in=float(np.abs(Z[sel]).min()), residual=rel,
+                   coef=coef)
     f, z = fit.backbone(q_top)
     return SweepFit(**{**fit.__dict__, "f_hz": float(f), "zeta": float(z)})
