@@ -101,7 +101,9 @@ def test_response_in_m_s2_gives_the_same_modal_table(tmp_path):
     pa, pb = measure_run(a, row, modal_kw={"mass_lbf": 1.0})[2], measure_run(b, row, modal_kw={"mass_lbf": 1.0})[2]
     for key, v in pa.items():
         if isinstance(v, float) and np.isfinite(v):
-            assert pb[key] == pytest.approx(v, rel=1e-8), key
+            # the fits' relative misfits of a noise-free record are float round-off themselves (< 1e-5):
+            # equal to 1e-9 absolute, every physical quantity to 1e-8 relative
+            assert pb[key] == pytest.approx(v, rel=1e-8, abs=1e-9 if key.endswith("_residual") else 0), key
         else:
             assert pb[key] == v or (v != v and pb[key] != pb[key]), key
     assert pa["f_res_method"] == "sweep_fit" and pa["zeta_sweep"] == pytest.approx(ZETA, rel=0.01)

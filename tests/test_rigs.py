@@ -16,11 +16,42 @@ from jointcal.modal import measure_run
 from jointcal.models import G, IwanParams, MinistackModel
 from jointcal.synth import generate, load_spec
 from jointcal.synth.daq import controlled_sweep
-from jointcal.synth.shaker import Shaker, _rig_poly, rig_pole, simulate_rig
+from jointcal.synth.shaker import Shaker, StructureMode, _rig_poly, _x_over_v, rig_matrices, rig_pole, simulate_rig
 
 BEAM = {"k": 1022.0, "zeta_v": 0.015, "weight_lbf": 1.0}  # 100 Hz, zeta 1.5%, linear
 SHAKER = {"armature_weight_lbf": 0.05, "suspension_hz": 15.0, "bl_lbf_per_A": 0.5, "coil_ohm": 2.0, "coil_mH": 0.3}
 MINISTACK = {"Fs": 313.0, "KT": 1.02e6, "chi": -0.65, "beta": 0.004, "k": 6.12e5, "zeta_v": 0.0015}
+
+
+def test_rig_with_a_second_mode_matches_its_analytic_frf_and_poles():
+    """A second linear mode at the driving point (250 Hz): the 5-state time integration's H1 of the
+    driving point's acceleration over the voltage against the closed form -w^2 x/V (1 + S_1/S_2), and the
+    rig's poles from the characteristic polynomial against the state matrix's eigenvalues (independent
+    paths: matrix exponentials of a 3x3 solve, a frequency-domain elimination, polynomial roots)."""
+    m = BEAM["weight_lbf"] / G
+    model, sh = MinistackModel(m=m, k=BEAM["k"], zeta_v=BEAM["zeta_v"]), Shaker(**SHAKER)
+    second = StructureMode(f_hz=250.0, zeta=0.01, weight_lbf=0.5)
+    eig = np.linalg.eigvals(rig_matrices(model, sh, second)[0])
+    eig = eig[eig.imag > 0]
+    fr, zr = rig_pole(model, sh, 1.0, second)
+    lam = eig[np.argmin(np.abs(np.abs(eig) - 2 * np.pi * fr))]
+    assert abs(lam) / (2 * np.pi) == pytest.approx(fr, rel=1e-9) and -lam.real / abs(lam) == pytest.approx(zr, rel=1e-7)
+    f1 = rig_pole(model, sh, 1.0)[0]
+    assert fr != pytest.approx(f1, rel=1e-4)  # the second mode's flexibility moves the first
+    fs = 2048.0
+    t, _, v = controlled_sweep(2 * fs, 60.0, 320.0, 20.0, 1.0, rng=np.random.default_rng(0), ramp_s=0.05,
+                               tail_s=1.0, ripple=0.0, distortion=(0.0, 0.0))
+    acc, _, _ = simulate_rig(model, sh, v, 2 * fs, second=second)
+    tab, _ = record_frf(v[::2], acc[::2], fs, "voltage", (60.0, 320.0))
+    f = tab["freq_hz"].to_numpy()
+    w = 2 * np.pi * f
+    s1 = model.k - m * w**2 + 1j * w * 2 * model.zeta_v * np.sqrt(model.k * m)
+    s2 = second.k - second.m * w**2 + 1j * w * second.c
+    h = -(w**2) * _x_over_v(model, sh, 1.0, w, second) * (1 + s1 / s2) / G
+    H = (tab["h1_re"] + 1j * tab["h1_im"]).to_numpy()
+    for fc, zc in ((fr, zr), (250.0, 0.01)):
+        near = np.abs(f - fc) <= 2 * max(zc, 0.01) * fc
+        assert np.abs(np.abs(H[near]) / np.abs(h[near]) - 1).max() < 5e-3
 
 
 def test_time_simulation_of_the_rig_matches_its_analytic_frf():

@@ -177,7 +177,7 @@ def _half_power_zeta(f: NDArray, a: NDArray, ip: int) -> float:
 
 def fit_mode(f: NDArray, X: NDArray, f_band: tuple[float, float], *, span: float = 2.0,
              f_guess: float | None = None, modal_phase: float | None = None) -> ModeFit:
-    """Single-mode rational fit of the strongest peak of X in f_band.
+    """Single-mode rational fit of the strongest interior peak of X in f_band (or the one at f_guess).
 
     Parameters
     ----------
@@ -191,7 +191,7 @@ def fit_mode(f: NDArray, X: NDArray, f_band: tuple[float, float], *, span: float
         the single mode dominates and a nonlinear structure's amplitude is near its
         peak value; the residual terms take the rest.
     f_guess : float, optional
-        Start near this frequency (Hz) instead of the largest |X| in the band.
+        Start near this frequency (Hz) instead of the largest interior peak of |X| in the band.
     modal_phase : float, optional
         The modal constant's phase when physics fixes it (rad): pi for z / a_base, 0 for
         x / F. The quadrature is then read on the measured ratio itself, which for a
@@ -210,7 +210,11 @@ def fit_mode(f: NDArray, X: NDArray, f_band: tuple[float, float], *, span: float
     if inb.size < 8:
         raise ValueError(f"fewer than 8 FRF lines in {lo:g}-{hi:g} Hz; record a longer sweep.")
     a = np.abs(X[inb])
-    ip = int(np.argmax(a)) if f_guess is None else int(np.argmin(np.abs(f[inb] - f_guess)))
+    if f_guess is None:  # the largest interior peak (a displacement ratio grows without bound toward 0 Hz)
+        peaks, _ = signal.find_peaks(a)
+        ip = int(peaks[np.argmax(a[peaks])]) if peaks.size else int(np.argmax(a))
+    else:
+        ip = int(np.argmin(np.abs(f[inb] - f_guess)))
     fn, zeta = float(f[inb][ip]), _half_power_zeta(f[inb], a, ip)
     for _ in range(3):  # the fitted band follows the fitted mode
         sel = inb[np.abs(f[inb] - fn) <= span * max(zeta, 2 * (f[1] - f[0]) / fn) * fn]

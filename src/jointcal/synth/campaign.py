@@ -21,7 +21,7 @@ from ..io import write_csv_atomic, write_json_atomic, write_run
 from ..models import G, resonance_amplitude, simulate
 from . import daq
 from .effects import effect_defaults, run_model
-from .shaker import Shaker, rig_truth, simulate_rig
+from .shaker import Shaker, StructureMode, rig_truth, simulate_rig
 from .spec import JOINT_KEYS, RIG_LEVEL, load_spec
 
 __all__ = ["generate", "plan_runs"]
@@ -123,6 +123,8 @@ def generate(spec: dict | str | os.PathLike, out_dir: str | os.PathLike, truth_p
     sw = spec["sweep"]
     ref = spec["rig"]["reference"]
     shaker = Shaker(**spec["rig"]["shaker"])
+    second = spec["rig"].get("second_mode")
+    second = None if second is None else StructureMode(**{k: float(v) for k, v in second.items()})
     plan = plan_runs(spec)
     masses = {a: v.get("weight_lbf", spec["slug_weight_lbf"]) / G for a, v in spec["assemblies"].items()}
     truth_rows = []
@@ -141,9 +143,9 @@ def generate(spec: dict | str | os.PathLike, out_dir: str | os.PathLike, truth_p
             reference, resp = drive, simulate(model, drive, fs_sim, omega_h=0.3).response_g  # truth finer than any estimator
             extra = _truth_row(truth, model, row.level_g)
         else:
-            resp, force, x = simulate_rig(model, shaker, drive, fs_sim, omega_h=0.3)
+            resp, force, x = simulate_rig(model, shaker, drive, fs_sim, omega_h=0.3, second=second)
             reference = force if ref == "force" else drive
-            extra = rig_truth(model, shaker, level, t, f_inst, x)
+            extra = rig_truth(model, shaker, level, t, f_inst, x, second=second)
             extra = dict(Fs=truth.get("Fs", np.nan), KT=truth.get("KT", np.nan), level_V=level, **extra)
             if ref == "force":  # the manifest's level: the force amplitude the gauge saw over the sweep
                 on = np.abs(drive) > 0

@@ -20,7 +20,9 @@ rig                  reference: base (the paper's closed-loop base-acceleration 
                      slug (`jointcal.synth.shaker`), recording the force gauge (force_lbf,
                      manifest level_lbf = the force amplitude over the sweep, lbf) or the
                      amplifier voltage (drive_V, level_V); shaker: armature_weight_lbf,
-                     suspension_hz, suspension_zeta, bl_lbf_per_A, coil_ohm, coil_mH.
+                     suspension_hz, suspension_zeta, bl_lbf_per_A, coil_ohm, coil_mH;
+                     second_mode (optional): {f_hz, zeta, weight_lbf}, a linear mode of
+                     the structure at the driving point beside the jointed one.
                      The sweep's rate_hz_per_s sets fast chirps as well (eta =
                      rate / (f zeta)^2 from 0.1 to 20 and beyond).
 measurement          noise_fraction (of each channel's RMS), dc_offset_g (std), bits,
@@ -41,7 +43,7 @@ from pathlib import Path
 import yaml
 
 from .effects import effect_defaults
-from .shaker import Shaker
+from .shaker import Shaker, StructureMode
 
 __all__ = ["DEFAULT_SPEC", "load_spec"]
 
@@ -209,8 +211,16 @@ def load_spec(spec: dict | str | os.PathLike) -> dict:
             raise ValueError(f"{where}: assembly {name!r} lacks {sorted(missing | (set(JOINT_KEYS) - set(joint)))} "
                              "(give k, zeta_v and all of Fs, KT, chi, beta, or none of these four for a linear structure).")
     rig = s["rig"]
-    if set(rig) - {"reference", "shaker"} or rig.get("reference") not in RIG_LEVEL:
-        raise ValueError(f"{where}: rig must be {{reference: base | force | voltage, shaker: {{...}}}}, got {rig}.")
+    if set(rig) - {"reference", "shaker", "second_mode"} or rig.get("reference") not in RIG_LEVEL:
+        raise ValueError(f"{where}: rig must be {{reference: base | force | voltage, shaker: {{...}}, "
+                         f"second_mode: {{f_hz, zeta, weight_lbf}} (optional)}}, got {rig}.")
+    if rig.get("second_mode") is not None:
+        if rig["reference"] == "base":
+            raise ValueError(f"{where}: rig.second_mode needs a shaker rig (reference force or voltage).")
+        try:
+            StructureMode(**{k: float(v) for k, v in rig["second_mode"].items()})
+        except (TypeError, ValueError, AttributeError) as exc:
+            raise ValueError(f"{where}: rig.second_mode: {exc}; its keys are f_hz, zeta, weight_lbf.") from None
     try:
         rig["shaker"] = {**Shaker().__dict__, **(rig.get("shaker") or {})}
         Shaker(**rig["shaker"])
