@@ -1,12 +1,13 @@
 # Shared paths and input functions of the jointcal workflow (logic lives in src/jointcal/).
-import csv
 import os
 import sys
+import warnings
 from pathlib import Path
 
 from snakemake.utils import validate
 
 from jointcal._workflow import config_problem, stage_hash
+from jointcal.io import CampaignError, CampaignWarning, read_manifest, write_bytes_atomic
 
 # Config: an unknown key (a typo) is one line naming the nearest valid key, before the schema's own
 # validation (whose message is a dump of the schema); nested --config values given as text are converted.
@@ -38,21 +39,32 @@ if not MANIFEST.is_file():
     )
 
 
+def _campaign_table():
+    """The manifest, read and checked at parse time by jointcal.io.read_manifest.
+
+    A Windows path, a listed file that is missing or any other manifest problem stops the
+    workflow here with the one-sentence message on stderr and in the ingest log, before
+    Snakemake looks for the rule inputs (its MissingInputException names no fix). Notes on
+    the manifest (empty trailing rows) are left to the ingest stage's log.
+    """
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", CampaignWarning)
+            return read_manifest(MANIFEST)
+    except CampaignError as exc:
+        write_bytes_atomic(f"jointcal: {exc}\n".encode(), RESULTS / "logs" / "ingest.log")
+        sys.exit(f"jointcal: {exc}")
+
+
+CAMPAIGN = _campaign_table()
+RUN_FILES = {rid: str(RAW_DATA / f) for rid, f in zip(CAMPAIGN["run_id"], CAMPAIGN["file"])}
+RUN_IDS = list(RUN_FILES)
+ASSEMBLIES = list(dict.fromkeys(CAMPAIGN["assembly"]))
+
+
 def campaign_files(wildcards):
     """The manifest and every run file it lists (validation itself is jointcal.io's job)."""
-    with open(MANIFEST, newline="", encoding="utf-8-sig") as fh:
-        listed = [(r.get("file") or "").strip() for r in csv.DictReader(fh)]
-    return {"manifest": str(MANIFEST), "runs": [str(RAW_DATA / f) for f in listed if f]}
-
-
-def _manifest_rows():
-    with open(MANIFEST, newline="", encoding="utf-8-sig") as fh:
-        return [{k.strip(): (v or "").strip() for k, v in r.items()} for r in csv.DictReader(fh)]
-
-
-RUN_FILES = {r["run_id"]: str(RAW_DATA / r["file"]) for r in _manifest_rows() if r.get("run_id")}
-RUN_IDS = list(RUN_FILES)
-ASSEMBLIES = list(dict.fromkeys(r["assembly"] for r in _manifest_rows() if r.get("assembly")))
+    return {"manifest": str(MANIFEST), "runs": list(RUN_FILES.values())}
 
 
 def run_record(wildcards):
@@ -73,7 +85,7 @@ def ingest_table(wildcards):
 
 def assembly_records(wildcards):
     """The raw records of one assembly's runs."""
-    return [str(RAW_DATA / r["file"]) for r in _manifest_rows() if r.get("assembly") == wildcards.assembly]
+    return [RUN_FILES[rid] for rid, asm in zip(CAMPAIGN["run_id"], CAMPAIGN["assembly"]) if asm == wildcards.assembly]
 
 
 def remove_stale_outputs():
