@@ -24,7 +24,7 @@ from _campaign import REPO, edit_manifest, edit_run, example_copy, workflow_copy
 from jointcal._amplitudes import low_frequency_ratio
 from jointcal._checks import _check_time, time_resolution
 from jointcal.cli import main
-from jointcal.io import CampaignError, CampaignWarning, ingest_campaign, read_manifest, read_run
+from jointcal.io import CampaignError, CampaignWarning, ingest_campaign, read_manifest, read_run, validate_run
 
 G_SI = 9.80665  # m/s^2 per g
 RUN, OTHER = "first_01_1g_up", "first_07_2g_up"  # a 1 g up sweep and a 2 g one, from raw_data/
@@ -160,6 +160,33 @@ def test_units_check_has_no_false_positive_on_synthetic_campaigns(tmp_path, effe
         low = low_frequency_ratio(df["base_accel_g"].to_numpy(), df["response_accel_g"].to_numpy(), 12800.0,
                                   row["f_start_hz"], row["f_stop_hz"], row["sweep_rate_hz_per_s"])
         assert low[1] > 1.18  # by physics, not by units
+
+
+def test_units_check_says_nothing_when_another_mode_sits_at_the_band_bottom():
+    """A second mode at 745 Hz (participation 0.5) lifts the response/base ratio at the 700 Hz band bottom to
+    7.5 times a single mode's rise, inside the m/s^2 band: the ratio does not follow one mode over the first
+    quarter of the way to the 2.2 kHz peak, so nothing is named (exact linear responses, scipy.signal.lsim)."""
+    from scipy import signal
+
+    fs, f0, f1, rate = 12800.0, 700.0, 2600.0, 1000.0
+    t = np.arange(int(((f1 - f0) / rate + 0.05) * fs)) / fs
+    tt = np.minimum(t, (f1 - f0) / rate)
+    base = np.sin(2 * np.pi * (f0 * tt + 0.5 * rate * tt**2)) * (t < (f1 - f0) / rate)
+
+    def relative_accel(fn: float, zeta: float) -> np.ndarray:  # z'' of z'' + 2 zeta w z' + w^2 z = -a_base
+        w = 2 * np.pi * fn
+        sdof = signal.StateSpace([[0.0, 1.0], [-w * w, -2 * zeta * w]], [[0.0], [-1.0]], [[-w * w, -2 * zeta * w]],
+                                 [[0.0]])
+        return signal.lsim(sdof, base, t)[1] - base
+
+    resp = base + relative_accel(2200.0, 0.02) + 0.5 * relative_accel(745.0, 0.02)
+    assert low_frequency_ratio(base, resp, fs, f0, f1, rate) is None
+    row = {"run_id": "r", "assembly": "a", "sequence": 1, "level_g": 1.0, "direction": "up", "f_start_hz": f0,
+           "f_stop_hz": f1, "sweep_rate_hz_per_s": rate, "sample_rate_hz": fs, "file": "r.csv"}
+    df = pd.DataFrame({"time_s": t, "base_accel_g": base, "response_accel_g": resp})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert validate_run(df, row, "r.csv")["flags"] == []
 
 
 def test_a_voltage_driven_response_in_other_units_cannot_be_seen_and_the_contract_says_so(voltage):

@@ -21,6 +21,7 @@ UNIT_RTOL = 0.015  # a ratio this close to a unit factor is named as a units mis
 SWAP_PEAK = 2.0  # a controlled reference never peaks at twice its median amplitude over the sweep
 RESPONSE_UNIT_BAND = 1.5  # a response scale within this factor of another unit's is named as that unit
 LOW_RATIO_MAX = 0.8  # the response-units check needs the band to start below 0.8 x the resonance
+QUASI_STATIC, QUASI_STATIC_SPREAD = 0.25, 1.25  # ... and one mode's rise over the first quarter, within 1.25
 # excitation -> {unit a record or level may wrongly be in: the contract unit's size in it}
 UNIT_FACTORS = {kind: {u: 1.0 / size for u, size in UNITS[q].items() if size != 1.0} for kind, q in QUANTITY.items()}
 PLATEAU = 1.25  # a held drive's amplitude quartiles lie within this ratio (a 1 % ripple: 1.01)
@@ -128,8 +129,10 @@ def low_frequency_ratio(ref: NDArray[np.float64], resp: NDArray[np.float64], fs:
     (f_low, ratio, f_peak) or None
         The lowest window's drive frequency (Hz), |H| there, and the drive frequency
         where |H| peaks (Hz); None when the peak lies in the band's first or last
-        window (no resonance in the band) or `f_low` is above ``LOW_RATIO_MAX``
-        x `f_peak` (the band starts too close to resonance).
+        window (no resonance in the band), `f_low` is above ``LOW_RATIO_MAX``
+        x `f_peak` (the band starts too close to resonance), or the ratio over the
+        first ``QUASI_STATIC`` of the way to the peak, times ``1 - (f / f_peak)^2``,
+        spreads by more than ``QUASI_STATIC_SPREAD`` (another mode down there).
 
     Notes
     -----
@@ -162,7 +165,14 @@ def low_frequency_ratio(ref: NDArray[np.float64], resp: NDArray[np.float64], fs:
         return None
     low = np.argsort(f)[:3]
     f_low, ratio, f_peak = float(np.median(f[low])), float(np.median(gain[low])), float(f[k])
-    return None if f_low > LOW_RATIO_MAX * f_peak else (f_low, ratio, f_peak)
+    if f_low > LOW_RATIO_MAX * f_peak:
+        return None
+    # the bottom quarter of the way to the peak must follow one mode's rise (no other mode down there)
+    below = (f <= f_low + QUASI_STATIC * (f_peak - f_low)) & (f < f_peak)
+    rise = gain[below] * (1.0 - (f[below] / f_peak) ** 2)
+    if below.sum() < 3 or rise.max() > QUASI_STATIC_SPREAD * rise.min():
+        return None
+    return f_low, ratio, f_peak
 
 
 def _quadrature(x: NDArray[np.float64]) -> NDArray[np.float64]:
