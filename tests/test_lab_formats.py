@@ -287,3 +287,9 @@ def test_workflow_reads_lab_exports_as_it_reads_the_csv(tmp_path, voltage_source
         tables[name] = pd.read_csv(out / "modal" / "modal_properties.csv", keep_default_na=False)
     assert (tables["lab"]["f_res_method"] == "sweep_fit").all()
     pd.testing.assert_frame_equal(tables["lab"], tables["csv"])
+
+
+def test_a_lab_export_read_without_its_manifest_row_says_so(tmp_path, example_src):
+    folder = _lab_campaign(example_src, tmp_path / "c", ".uff", {"base_accel_g": "g", "response_accel_g": "g"})
+    with pytest.raises(CampaignError, match="a UFF 58 record needs its manifest row"):
+        read_run(folder / f"runs/{EXAMPLE_RUN}.uff")

@@ -118,12 +118,12 @@ def read_lab_export(path: Path, kind: Excitation | None, channels: Mapping[str, 
         The run, named in messages.
     """
     fmt = FORMATS[path.suffix.lower()]
-    found = {"UFF 58": _uff_channels, "TDMS": _tdms_channels, "Test.Lab MAT": _testlab_channels}[fmt](path)
-    listed = ", ".join(repr(c.names[0]) for c in found) or "none"
-    run = f" of run {run_id!r}" if run_id else ""
     if kind is None:
         fail(path, f"a {fmt} record needs its manifest row (the level column gives its excitation)",
              "read it with read_run(path, row)")
+    found = {"UFF 58": _uff_channels, "TDMS": _tdms_channels, "Test.Lab MAT": _testlab_channels}[fmt](path)
+    listed = ", ".join(repr(c.names[0]) for c in found) or "none"
+    run = f" of run {run_id!r}" if run_id else ""
     picked = {}
     for role, column in (("reference", REFERENCE[kind]), ("response", RESPONSE)):
         want = channels.get(role)
