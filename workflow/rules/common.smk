@@ -1,4 +1,5 @@
 # Shared paths and input functions of the jointcal workflow (logic lives in src/jointcal/).
+import csv
 import os
 import sys
 import warnings
@@ -39,36 +40,51 @@ if not MANIFEST.is_file():
     )
 
 
-def _campaign_table():
-    """The manifest, read and checked at parse time by jointcal.io.read_manifest.
-
-    A Windows path, a listed file that is missing or any other manifest problem stops the
-    workflow here with the one-sentence message on stderr and in the ingest log, before
-    Snakemake looks for the rule inputs (its MissingInputException names no fix). Notes on
-    the manifest (empty trailing rows) are left to the ingest stage's log.
-    """
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", CampaignWarning)
-            return read_manifest(MANIFEST)
-    except CampaignError as exc:
-        write_bytes_atomic(f"jointcal: {exc}\n".encode(), RESULTS / "logs" / "ingest.log")
-        sys.exit(f"jointcal: {exc}")
+def _manifest_rows():
+    """The manifest's rows as text, read leniently at parse time (a workflow of the later stages only,
+    started from their tables, may hold a manifest of run_id, assembly and file alone)."""
+    with open(MANIFEST, newline="", encoding="utf-8-sig") as fh:
+        return [{(k or "").strip(): (v or "").strip() for k, v in r.items()} for r in csv.DictReader(fh)]
 
 
-CAMPAIGN = _campaign_table()
-RUN_FILES = {rid: str(RAW_DATA / f) for rid, f in zip(CAMPAIGN["run_id"], CAMPAIGN["file"])}
+RUN_FILES = {r["run_id"]: str(RAW_DATA / r.get("file", "")) for r in _manifest_rows() if r.get("run_id")}
 RUN_IDS = list(RUN_FILES)
-ASSEMBLIES = list(dict.fromkeys(CAMPAIGN["assembly"]))
+ASSEMBLIES = list(dict.fromkeys(r["assembly"] for r in _manifest_rows() if r.get("assembly")))
+_CHECKED = []
+
+
+def checked_campaign():
+    """Read and check the manifest once, with jointcal.io.read_manifest, in the input function of every rule
+    that reads raw records: a Windows path, a listed file that is missing or any other manifest problem
+    stops the workflow there with the one-sentence message on stderr and in the ingest log, before
+    Snakemake looks for the records (its MissingInputException names no fix). Notes on the manifest
+    (empty trailing rows) are left to the ingest stage's log."""
+    if not _CHECKED:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", CampaignWarning)
+                _CHECKED.append(read_manifest(MANIFEST))
+        except CampaignError as exc:
+            write_bytes_atomic(f"jointcal: {exc}\n".encode(), RESULTS / "logs" / "ingest.log")
+            sys.exit(f"jointcal: {exc}")
+    return _CHECKED[0]
 
 
 def campaign_files(wildcards):
-    """The manifest and every run file it lists (validation itself is jointcal.io's job)."""
+    """The manifest and every run file it lists, once the manifest is checked (checked_campaign)."""
+    checked_campaign()
     return {"manifest": str(MANIFEST), "runs": list(RUN_FILES.values())}
 
 
+def campaign_records(wildcards):
+    """Every run file the manifest lists, once the manifest is checked."""
+    checked_campaign()
+    return list(RUN_FILES.values())
+
+
 def run_record(wildcards):
-    """The raw record of one run."""
+    """The raw record of one run, once the manifest is checked."""
+    checked_campaign()
     return RUN_FILES[wildcards.run_id]
 
 
@@ -84,8 +100,9 @@ def ingest_table(wildcards):
 
 
 def assembly_records(wildcards):
-    """The raw records of one assembly's runs."""
-    return [RUN_FILES[rid] for rid, asm in zip(CAMPAIGN["run_id"], CAMPAIGN["assembly"]) if asm == wildcards.assembly]
+    """The raw records of one assembly's runs, once the manifest is checked."""
+    table = checked_campaign()
+    return [RUN_FILES[rid] for rid, asm in zip(table["run_id"], table["assembly"]) if asm == wildcards.assembly]
 
 
 def remove_stale_outputs():
