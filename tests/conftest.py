@@ -5,7 +5,7 @@ import shutil
 from pathlib import Path
 
 import pytest
-from _campaign import SMALL_CAMPAIGN
+from _campaign import SMALL_CAMPAIGN, voltage_campaign
 
 
 @pytest.fixture
@@ -18,3 +18,15 @@ def small_campaign() -> Path:
 def campaign(tmp_path: Path) -> Path:
     """A writable copy of the small campaign, to break in a test."""
     return Path(shutil.copytree(SMALL_CAMPAIGN, tmp_path / "campaign"))
+
+
+@pytest.fixture(scope="session")
+def voltage_source(tmp_path_factory) -> Path:
+    """A synthetic voltage-driven campaign, made once per session (read only)."""
+    return voltage_campaign(tmp_path_factory.mktemp("voltage") / "campaign")
+
+
+@pytest.fixture
+def voltage(tmp_path: Path, voltage_source: Path) -> Path:
+    """A writable copy of the synthetic voltage-driven campaign, to break in a test."""
+    return Path(shutil.copytree(voltage_source, tmp_path / "voltage"))

@@ -1,4 +1,4 @@
-"""Input checks that catch what changes answers (issue 11): each bad input gets one sentence
+"""Input checks that catch what changes answers: each bad input gets one sentence
 naming the file, the problem and the fix; data problems are flags that keep the run out of
 the calibration; contract violations stop the run, leaving no output behind."""
 from __future__ import annotations

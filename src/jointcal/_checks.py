@@ -1,6 +1,7 @@
 """Checks of one run record against its manifest row (`validate_run`, re-exported by `jointcal.io`).
 
-Also the signal helpers it uses: clipping runs and the drive frequency of a short window.
+Also the drive frequency of a short window; clipping is found by `jointcal._clipping`
+(its `clip_levels` and `clipped_mask` are re-exported here).
 """
 from __future__ import annotations
 
@@ -13,143 +14,22 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from jointcal._amplitudes import level_problems, swap_problem, window_amplitudes
+from jointcal._clipping import clip_levels, clipped_mask
 from jointcal._contract import (
-    FS_RTOL, LEVEL, MIN_CYCLES, REFERENCE, RESPONSE, TIME, CampaignError, CampaignWarning,
-    OnDataProblem, excitation_of, fail,
+    FS_RTOL, LEVEL, MIN_CYCLES, REFERENCE, RESPONSE, TIME, CampaignError, CampaignWarning, OnDataProblem,
+    excitation_of, fail,
 )
 
-__all__ = ["validate_run", "clipped_mask", "clip_levels", "UNUSABLE_FLAGS"]
+__all__ = ["validate_run", "clipped_mask", "clip_levels", "window_amplitudes", "time_resolution", "UNUSABLE_FLAGS"]
 
-LEVEL_RTOL = 0.10  # reference amplitude vs the manifest's level: 10x a controller's normal 1 % ripple
-UNIT_RTOL = 0.015  # a ratio this close to a unit factor is named as a units mistake (example: within 0.2 %)
-SWAP_PEAK = 2.0  # a controlled reference never peaks at twice its median amplitude over the sweep
-UNIT_FACTORS = {  # excitation -> {unit a record or level may wrongly be in: its size in the contract's unit}
-    "base": {"m/s^2": 9.80665, "in/s^2": 386.089, "ft/s^2": 32.174},
-    "force": {"N": 4.44822},
-}
 TIME_UNITS = {"milliseconds": 1e-3, "microseconds": 1e-6, "minutes": 60.0}  # unit -> its size in s
 # ingest flags whose run must not enter a calibration: its amplitudes or channels are wrong, or
 # it is clipped (a linear SDOF clipped at 95-60 % of its resonance peak gives damping 14-138 %
 # high even with the frames touching clipped samples left out: the peak itself is missing)
-UNUSABLE_FLAGS = ("level", "swapped", "constant", "clipped")
-
-
-def quantum(v: NDArray[np.float64]) -> float:
-    """Quantisation step of a channel near its extremes (unit of `v`).
-
-    The smallest spacing between distinct values among the 4096 largest and the 4096
-    smallest finite samples of `v` (shape (n,)) strictly inside its range (a clipped
-    extreme holds one value): the ADC's LSB for quantised data. At most 1e-3 of the
-    range (a 10-bit ADC), at least 1e-12 of the largest magnitude (float rounding).
-    """
-    v = v[np.isfinite(v)]
-    if v.size < 2:
-        return 0.0
-    lo, hi = float(v.min()), float(v.max())
-    inner = v[(v > lo) & (v < hi)]
-    step = 1e-3 * (hi - lo)
-    if inner.size >= 2:
-        k = min(inner.size, 4096)
-        tails = np.unique(np.concatenate((np.partition(inner, inner.size - k)[inner.size - k:],
-                                          np.partition(inner, k - 1)[:k], [lo, hi])))
-        step = min(step, float(np.diff(tails).min()))
-    return max(step, 1e-12 * max(abs(lo), abs(hi)))
-
-
-def clip_levels(x: NDArray[np.float64], min_count: int = 3) -> list[tuple[float, int, int]]:
-    """Find the extreme values at which a channel is clipped, from its amplitude distribution.
-
-    Parameters
-    ----------
-    x : ndarray of float, shape (n,)
-        One channel (any unit). Non-finite samples are ignored.
-    min_count : int
-        Fewest samples at one extreme that count as clipping (>= 2).
-
-    Returns
-    -------
-    list of (value, count, first)
-        For the maximum and the minimum separately: the clipped value (unit of `x`),
-        the number of samples within one quantisation step of it, and the index of
-        the first; empty when the channel is clean.
-
-    Notes
-    -----
-    A clipped channel piles up at its full scale: many samples sit exactly at (or
-    within one quantisation step of) the same extreme value, whatever the length of
-    each flat top (at 2.2 kHz sampled at 12.8 kHz, a clip at 95 % of the peak lasts
-    one sample per half cycle). A noisy swept sine reaches its extreme once, and its
-    next-highest samples are spread below it. An extreme counts as clipped when
-    `min_count` consecutive samples sit within one step of it (a flat top no sine
-    has), or when
-
-    * at least `min_count` samples sit within one step of it,
-    * they outnumber three times the samples in the band just below it, of width
-      ``max(3 steps, 1e-3 (extreme - median))`` (the histogram's pile-up at the
-      extreme: a noiseless synthetic chirp may hit its crest exactly on a few samples,
-      but far more of its samples then lie just below), and
-    * they outnumber twice the samples at the value nearest the median (a noiseless
-      tone at a rational frequency repeats every value, not only its extremes).
-
-    The step is the smallest spacing of the distinct values near the extremes (the
-    ADC's LSB for quantised data; float rounding otherwise). A constant channel and
-    an extreme of exactly 0 (a silent channel) are not clipping. Clipping at 60-99 %
-    of the peak is found in 24- and 16-bit records at 12.8 and 25.6 kHz; a 12-bit
-    record may hide a slight clip in its coarse steps.
-    """
-    if min_count < 2:
-        raise ValueError(f"min_count must be >= 2, got {min_count}")
-    finite = np.isfinite(x)
-    v = x[finite]
-    if v.size < 2 or v.max() == v.min():
-        return []
-    step = quantum(v)
-    tol = 1.001 * step
-    centre = float(np.median(v))
-    found = []
-    for sign in (1.0, -1.0):
-        y = sign * v  # the maximum of y is the channel's maximum (sign 1) or minimum (sign -1)
-        top, c = float(y.max()), sign * centre
-        if top == 0.0:
-            continue
-        at = y >= top - tol
-        below = (y >= top - max(3.001 * step, 1e-3 * (top - c))) & ~at
-        mid = y[np.argmin(np.abs(y - c))]
-        n_at, n_below = int(np.count_nonzero(at)), int(np.count_nonzero(below))
-        n_mid = int(np.count_nonzero(np.abs(y - mid) <= tol))
-        edges = np.diff(np.concatenate(([0], at.astype(np.int8), [0])))
-        longest = int((np.flatnonzero(edges == -1) - np.flatnonzero(edges == 1)).max())
-        if longest >= min_count or (n_at >= min_count and n_at > 3 * n_below and n_at > 2 * n_mid):
-            first = int(np.flatnonzero(finite)[np.argmax(at)])
-            found.append((sign * top, n_at, first))
-    return found
-
-
-def clipped_mask(x: NDArray[np.float64], min_count: int = 3) -> NDArray[np.bool_]:
-    """Samples at a clipped extreme that `clip_levels` finds (same definition).
-
-    Parameters
-    ----------
-    x : ndarray of float, shape (n,)
-        One channel.
-    min_count : int
-        Fewest samples at one extreme that count as clipping.
-
-    Returns
-    -------
-    ndarray of bool, shape (n,)
-        True for every sample within one quantisation step of a clipped maximum or
-        minimum (the samples whose true value is unknown).
-    """
-    mask = np.zeros(x.shape, dtype=bool)
-    levels = clip_levels(x, min_count)
-    if not levels:
-        return mask
-    v = x[np.isfinite(x)]
-    step = quantum(v)
-    for value, _, _ in levels:
-        mask |= np.abs(x - value) <= step * 1.001
-    return mask
+UNUSABLE_FLAGS = ("level", "units", "swapped", "constant", "clipped")
+JITTER = 0.02  # samples further than this many steps off a uniform grid (beyond the times' rounding) are jitter
+HEAD_LEVEL = 0.1  # a head quieter than this fraction of the reference's amplitude is silent
 
 
 def peak_frequency(x: NDArray[np.float64], fs: float, *, pad: int = 16) -> float:
@@ -195,7 +75,8 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
     Parameters
     ----------
     df : pandas.DataFrame
-        The record as returned by `read_run`.
+        The record as returned by `read_run` (its ``attrs['sources']`` name the
+        response's declared unit in messages).
     row : mapping
         Its manifest row (see `read_manifest`).
     path : path-like
@@ -205,7 +86,8 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
         step) that count as clipping, flat tops of any length (see `clip_levels`).
     on_data_problem : {'error', 'flag'}, optional
         What to do with data problems (NaN/inf values, a constant channel, clipping,
-        swapped channels, a reference amplitude off the manifest's level): raise, or
+        swapped channels, a reference amplitude off the manifest's level, a base-driven
+        response in other units than declared): raise, or
         record them in ``flags`` and emit a `CampaignWarning` with the same sentence.
         Structural problems always raise.
 
@@ -213,24 +95,26 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
     -------
     dict
         ``n_samples``; ``duration_s`` (n / fs, s); ``fs_measured_hz`` (Hz);
-        ``excitation`` ('base' or 'force'); ``rms_base_accel_g`` (g),
-        ``rms_force_lbf`` (lbf), ``rms_response_accel_g`` (g) (NaN for the absent
-        reference); ``f_first_hz`` and ``f_last_hz``, the drive frequency measured in
+        ``excitation`` ('base', 'force' or 'voltage'); ``rms_base_accel_g`` (g),
+        ``rms_force_lbf`` (lbf), ``rms_drive_V`` (V), ``rms_response_accel_g`` (g)
+        (NaN for the absent references); ``f_first_hz`` and ``f_last_hz``, the drive frequency measured in
         a short window at the record's start and at the sweep's expected end time
         (which a free-decay tail may follow), each referred to that instant with the
         manifest's sweep rate (Hz); ``f_tolerance_hz``, the allowed deviation from
         ``f_start_hz``/``f_stop_hz`` (Hz) (the three NaN when the reference holds no
         signal); ``flags``, a list such as ``['nonfinite:response_accel_g',
         'clipped:base_accel_g']``; the words are ``nonfinite``, ``constant``,
-        ``clipped``, ``swapped`` and ``level`` (see `UNUSABLE_FLAGS`).
+        ``clipped``, ``swapped``, ``level`` and ``units`` (see `UNUSABLE_FLAGS`).
 
     Raises
     ------
     CampaignError
         Wrong columns or excitation kind, too few samples, non-finite or
-        non-increasing or gapped time, sample rate off the manifest by > 0.1 %,
-        a record shorter than 95 % of the sweep, a start or end drive frequency off
-        the manifest band by more than ``f_tolerance_hz``; with
+        non-increasing or gapped or jittered time (see `time_resolution`), sample
+        rate off the manifest by > 0.1 %, a record shorter than 95 % of the sweep, a
+        start or end drive frequency off the manifest band by more than
+        ``f_tolerance_hz`` (named as a silent pre-trigger head when the record fits
+        the band from the drive's onset on); with
         ``on_data_problem='error'`` also the data problems.
 
     Notes
@@ -240,13 +124,12 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
     of the sweep. The tolerance is ``rate * W / 2 + 1 / W``: the frequency swept
     within half the window plus one FFT bin.
 
-    The reference's median amplitude over 20-cycle windows of the sweep must be the
-    manifest's level within ``LEVEL_RTOL`` (10 %: ten times a controller's normal
-    ripple; the example campaign is within 0.2 %); a ratio within ``UNIT_RTOL``
-    (1.5 %) of a unit factor (9.80665 for m/s^2, 386.089 for in/s^2, 4.44822 for N)
-    is named as a units mistake, any other as a wrong level or sensitivity. A
-    reference peaking at more than ``SWAP_PEAK`` times its median while the response
-    stays flatter than half that is taken for swapped columns.
+    The amplitude checks (swapped columns, the reference against the manifest's level,
+    a base-driven response's units) are `jointcal._amplitudes`'; swapped columns are
+    looked for before the band, whose drive is then the response column.
+
+    Time samples more than ``JITTER`` (2 %) of a step off the best uniform grid,
+    beyond the rounding of the way the times were written, are jitter.
     """
     if on_data_problem not in ("error", "flag"):
         raise ValueError(f"on_data_problem must be 'error' or 'flag', got {on_data_problem!r}")
@@ -257,7 +140,8 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
         fail(path, f"it holds {REFERENCE[kind]} but the manifest gives {LEVEL[want]} for run {run}",
              f"export {REFERENCE[want]} or correct the manifest's level column")
     t = df[TIME].to_numpy(np.float64)
-    chans = {c: df[c].to_numpy(np.float64) for c in (REFERENCE[kind], RESPONSE)}
+    ref = REFERENCE[kind]
+    chans = {c: df[c].to_numpy(np.float64) for c in (ref, RESPONSE)}
     f0, f1, rate = float(row["f_start_hz"]), float(row["f_stop_hz"]), float(row["sweep_rate_hz_per_s"])
     fs = _check_time(t, float(row["sample_rate_hz"]), path, run)
     sweep_s = abs(f1 - f0) / rate
@@ -267,28 +151,59 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
              f"check f_start_hz, f_stop_hz and sweep_rate_hz_per_s of run {run} or export the whole record")
 
     flags: list[str] = []
-    problems = _data_problems(t, chans, clip_run, path, run)
-    _report(problems, flags, on_data_problem)
-    ref = REFERENCE[kind]
+    drop = f"or remove run {run} from manifest.csv"
+    _report(_data_problems(t, chans, clip_run, path, run), flags, on_data_problem)
     silent = {f.split(":", 1)[1] for f in flags if f.split(":", 1)[0] == "constant"}
     silent |= {c for c, x in chans.items() if not np.isfinite(x).any()}
+    amp = {c: window_amplitudes(x, fs, f0, f1, rate) for c, x in chans.items()}
+    swapped = [] if silent else swap_problem(amp, kind, path, drop)
+    _report(swapped, flags, on_data_problem)  # before the band: a swapped pair is not a wrong band
+    drive = chans[RESPONSE if swapped else ref]
     if ref in silent:  # no drive to measure: the flag says why, not a misleading band error
         f_first = f_last = tol = float("nan")
     else:
-        f_first, f_last, tol = _drive_band(chans[ref], fs, f0, f1, rate)
+        f_first, f_last, tol = _drive_band(drive, fs, f0, f1, rate)
     for label, got, exp in (("start", f_first, f0), ("end", f_last, f1)):
         if abs(got - exp) > tol:
+            _check_head(drive, amp[RESPONSE if swapped else ref], fs, f0, f1, rate, path, run, band)
             fail(path, f"the drive frequency at the sweep {label} is {got:.0f} Hz, not {exp:g} Hz "
                  f"(+/- {tol:.0f} Hz) as the manifest band {band} says",
                  f"correct direction, f_start_hz, f_stop_hz or sweep_rate_hz_per_s of run {run}"
                  + (f" (the record's data problems first: {', '.join(flags)})" if flags else ""))
-    if not silent:
-        _report(_amplitude_problems(chans, kind, row, fs, sweep_s, path, run), flags, on_data_problem)
+    if not silent and not swapped:
+        _report(level_problems(chans, amp, kind, row, fs, path, run, drop, df.attrs.get("sources", {})), flags,
+                on_data_problem)
     rms = {f"rms_{c}": float("nan") for c in (*REFERENCE.values(), RESPONSE)}
     rms.update({f"rms_{c}": float(np.sqrt(np.mean(x[np.isfinite(x)] ** 2))) for c, x in chans.items()
                 if np.isfinite(x).any()})
     return {"n_samples": t.size, "duration_s": t.size / fs, "fs_measured_hz": fs, "excitation": kind, **rms,
             "f_first_hz": f_first, "f_last_hz": f_last, "f_tolerance_hz": tol, "flags": flags}
+
+
+def _check_head(drive: NDArray[np.float64], amp: NDArray[np.float64], fs: float, f0: float, f1: float, rate: float,
+                path: object, run: str, band: str) -> None:
+    """Fail naming a silent pre-trigger head when the record, from the drive's onset on, fits the manifest band.
+
+    The head ends where the drive (median removed) first exceeds ``HEAD_LEVEL`` of its
+    median window amplitude `amp`; the onset is the first sample above six times the
+    head's noise (robust RMS of its first half), which finds the start of a ramp too.
+    """
+    if amp.size == 0 or not np.median(amp) > 0:
+        return
+    x = np.nan_to_num(np.abs(drive - np.nanmedian(drive)))
+    i_head = int(np.argmax(x > HEAD_LEVEL * float(np.median(amp))))
+    if i_head < 2:
+        return
+    noise = 1.4826 * float(np.median(x[: i_head // 2 + 1]))
+    i_on = int(np.argmax(x[: i_head + 1] > 6.0 * noise)) if noise > 0 else i_head
+    if i_on == 0 or drive.size - i_on < 0.95 * abs(f1 - f0) / rate * fs:
+        return
+    first, last, tol = _drive_band(drive[i_on:], fs, f0, f1, rate)
+    if abs(first - f0) <= tol and abs(last - f1) <= tol:
+        fail(path, f"the drive starts {i_on / fs:.4g} s after the record's first sample (a silent pre-trigger head "
+             f"of {i_on} samples), so the record does not start with the sweep {band}",
+             f"trim the head so that the record starts with the sweep, or give the sweep's start in the manifest's "
+             f"sweep_start_s column ({i_on / fs:.4g} for run {run})")
 
 
 def _check_time(t: NDArray[np.float64], fs: float, path: object, run: str) -> float:
@@ -317,7 +232,51 @@ def _check_time(t: NDArray[np.float64], fs: float, path: object, run: str) -> fl
     if abs(fs_meas / fs - 1) > FS_RTOL:
         fail(path, f"the measured sample rate {fs_meas:.6g} Hz differs from sample_rate_hz = {fs:g} Hz "
              f"by {abs(fs_meas / fs - 1):.2%}", f"correct sample_rate_hz for run {run} in manifest.csv")
+    i = np.arange(t.size, dtype=np.float64)
+    off = t - np.polyval(np.polyfit(i, t, 1), i)  # s, off the best uniform grid
+    excess = np.abs(off) - time_resolution(t) - JITTER * step
+    if (excess > 0).any():
+        k = int(np.argmax(np.abs(off)))
+        fail(path, f"time_s is not evenly spaced: sample {k} sits {abs(off[k]) / step:.1%} of a step off a uniform "
+             f"grid (at {t[k]:.9g} s; {np.count_nonzero(excess > 0)} samples beyond {JITTER:.0%}), more than the "
+             "times' rounding explains", "export the DAQ's own sample times (t0 + i / sample rate) or a record "
+             "resampled to a uniform grid")
     return float(fs_meas)
+
+
+def time_resolution(t: NDArray[np.float64]) -> NDArray[np.float64]:
+    """How far each time may sit off its true value from the way the times were written (s).
+
+    Parameters
+    ----------
+    t : ndarray of float, shape (n,)
+        Sample times (s).
+
+    Returns
+    -------
+    ndarray of float, shape (n,)
+        Half the rounding step of each time, under every way of writing that the values
+        fit exactly: a fixed number of decimals (``%.6f``: 5e-7 s), a number of
+        significant digits (``%.7g``: 5e-7 s at 1-10 s, 5e-6 s at 10-100 s) or single
+        precision (float32: 6e-8 of the time); 0 for times at full double precision.
+        A text export's rounding is not jitter.
+    """
+    sample = np.concatenate([t[:2000], t[t.size // 2: t.size // 2 + 2000], t[-2000:]])  # runs of neighbours
+    bound = np.zeros_like(t)
+    if np.array_equal(sample.astype(np.float32).astype(np.float64), sample):
+        bound = np.maximum(bound, 2.0**-24 * np.abs(t))
+    for k in range(0, 10):  # fixed decimals
+        x = sample * 10.0**k
+        if np.all(np.abs(x - np.rint(x)) <= 1e-6 + 1e-12 * np.abs(x)):
+            bound = np.maximum(bound, 0.5 * 10.0**-k)
+            break
+    nz, tz = sample[sample != 0], np.where(t != 0, np.abs(t), 1.0)
+    for d in range(1, 15):  # significant digits
+        q = 10.0 ** (np.floor(np.log10(np.abs(nz))) - d + 1)
+        if nz.size and np.all(np.abs(nz / q - np.rint(nz / q)) <= 1e-6):
+            bound = np.maximum(bound, 0.5 * 10.0 ** (np.floor(np.log10(tz)) - d + 1))
+            break
+    return bound
 
 
 def _data_problems(t: NDArray[np.float64], chans: dict[str, NDArray[np.float64]], clip_run: int,
@@ -354,85 +313,6 @@ def _report(problems: list[tuple[str, str]], flags: list[str], on_data_problem: 
             raise CampaignError(msg)
         warnings.warn(msg, CampaignWarning, stacklevel=3)
         flags.append(flag)
-
-
-def window_amplitudes(x: NDArray[np.float64], fs: float, sweep_s: float, f_low: float) -> NDArray[np.float64]:
-    """Amplitude of a channel in consecutive windows over the sweep (unit of `x`).
-
-    Parameters
-    ----------
-    x : ndarray of float, shape (n,)
-        One channel, sampled at `fs` (Hz) from the sweep's start.
-    fs : float
-        Sample rate (Hz).
-    sweep_s : float
-        Duration of the sweep (s); a free-decay tail after it is left out.
-    f_low : float
-        Lowest drive frequency (Hz): each window spans ``MIN_CYCLES`` of its cycles.
-
-    Returns
-    -------
-    ndarray of float, shape (k,)
-        ``sqrt(2) * RMS`` of each mean-removed window (the amplitude of a sine), for
-        the windows with more than half their samples finite.
-    """
-    n = max(int(round(MIN_CYCLES / f_low * fs)), 8)
-    m = min(x.size, int(round(sweep_s * fs))) // n
-    w = x[: m * n].reshape(m, n)
-    ok = np.isfinite(w)
-    keep = ok.mean(axis=1) > 0.5
-    w, ok = w[keep], ok[keep]
-    mean = np.where(ok, w, 0.0).sum(axis=1, keepdims=True) / ok.sum(axis=1, keepdims=True)
-    return np.sqrt(2.0 * np.where(ok, (w - mean) ** 2, 0.0).sum(axis=1) / ok.sum(axis=1))
-
-
-def _amplitude_problems(chans: dict[str, NDArray[np.float64]], kind: str, row: Mapping[str, Any], fs: float,
-                        sweep_s: float, path: object, run: str) -> list[tuple[str, str]]:
-    """(flag, one-sentence message) for swapped channels or a reference amplitude off the manifest's level.
-
-    Only for a controlled reference (base acceleration or force): the controller holds
-    its amplitude at the level within a ripple, so the median window amplitude is the
-    level and the largest is barely above it, while the response peaks at resonance.
-    """
-    if kind not in UNIT_FACTORS or LEVEL[kind] not in row:
-        return []
-    ref = REFERENCE[kind]
-    drop = f"or remove run {run} from manifest.csv"
-    f_low = min(float(row["f_start_hz"]), float(row["f_stop_hz"]))
-    amp = {c: window_amplitudes(x, fs, sweep_s, f_low) for c, x in chans.items()}
-    if min(a.size for a in amp.values()) < 3:
-        return []
-    flat = {c: float(a.max() / np.median(a)) if np.median(a) > 0 else np.inf for c, a in amp.items()}
-    if flat[ref] > SWAP_PEAK and flat[RESPONSE] < flat[ref] / 2:
-        return [(f"swapped:{ref}",
-                 f"{path}: column '{ref}' peaks at {flat[ref]:.3g} times its median amplitude while "
-                 f"'{RESPONSE}' stays within {flat[RESPONSE]:.2f} times (the controlled reference is flat, the "
-                 f"response peaks at resonance), so the two columns look swapped; export each channel under "
-                 f"its own name {drop}.")]
-    level, unit = float(row[LEVEL[kind]]), LEVEL[kind].split("_", 1)[1]
-    got = float(np.median(amp[ref]))
-    ratio = got / level
-    # a base acceleration is controlled to its level; a force often is not (an open-loop
-    # shaker's force drops out at the structure's resonance), so for a force only a
-    # units mistake or a factor of two counts
-    rtol = LEVEL_RTOL if kind == "base" else 1.0
-    if abs(ratio - 1) <= LEVEL_RTOL or (abs(np.log(ratio)) <= np.log(1 + rtol) and not any(
-            abs(ratio / f - 1) <= UNIT_RTOL or abs(ratio * f - 1) <= UNIT_RTOL for f in UNIT_FACTORS[kind].values())):
-        return []
-    what = "base" if kind == "base" else kind
-    said = (f"{what} amplitude is {got:.3g} {unit} where the manifest says {LEVEL[kind]} = {level:g} {unit} "
-            f"for run {run}")
-    for other, factor in UNIT_FACTORS[kind].items():
-        if abs(ratio / factor - 1) <= UNIT_RTOL:
-            chans_in = f"{ref} and {RESPONSE}" if kind == "base" else ref  # both accelerations share the unit
-            return [(f"level:{ref}", f"{path}: {said} (x{ratio:.4g}): is the record in {other}?; export "
-                     f"{chans_in} in {unit} (divide by {factor:g}) {drop}.")]
-        if abs(ratio * factor - 1) <= UNIT_RTOL:
-            return [(f"level:{ref}", f"{path}: {said} (x1/{1 / ratio:.4g}): is {LEVEL[kind]} written in {other}?; "
-                     f"write {LEVEL[kind]} of run {run} in {unit} in manifest.csv {drop}.")]
-    return [(f"level:{ref}", f"{path}: {said} (x{ratio:.3g}, more than {rtol:.0%} off): the manifest's level "
-             f"or the channel's sensitivity is wrong; correct {LEVEL[kind]} of run {run} in manifest.csv or the "
-             f"channel's calibration {drop}.")]
 
 
 def _drive_band(ref: NDArray[np.float64], fs: float, f0: float, f1: float,

@@ -19,7 +19,20 @@ LEVEL: dict[str, str] = {"base": "level_g", "force": "level_lbf", "voltage": "le
 # a response exported in m/s^2 under this name is converted to g (RESPONSE) on read
 RESPONSE_SI, G_SI = "response_accel_m_s2", 9.80665  # m/s^2 per g
 TEXT = ("run_id", "assembly", "direction", "file")
+START = "sweep_start_s"  # optional manifest column: the sweep's start after the record's first sample (s)
+# optional manifest columns naming a lab format's channels: role -> column
+CHANNEL_COLUMNS: dict[str, str] = {"reference": "reference_channel", "response": "response_channel"}
 POSITIVE = ("f_start_hz", "f_stop_hz", "sweep_rate_hz_per_s", "sample_rate_hz")
+# quantity of each channel role: a lab format's unit is checked against it and converted
+QUANTITY: dict[str, str] = {"base": "acceleration", "force": "force", "voltage": "voltage"}
+# the size of each unit a lab file may use, in the contract's unit of its quantity (g, lbf, V, s)
+UNITS: dict[str, dict[str, float]] = {
+    "acceleration": {"g": 1.0, "m/s^2": 1.0 / G_SI, "in/s^2": 1.0 / 386.089, "ft/s^2": 1.0 / 32.174,
+                     "mm/s^2": 1e-3 / G_SI},
+    "force": {"lbf": 1.0, "N": 1.0 / 4.4482216, "kN": 1e3 / 4.4482216},
+    "voltage": {"V": 1.0, "mV": 1e-3},
+    "time": {"s": 1.0, "ms": 1e-3},
+}
 FS_RTOL = 1e-3  # allowed relative sample-rate disagreement with the manifest
 MIN_CYCLES = 20  # cycles of the lowest drive frequency in each frequency window
 
@@ -41,39 +54,53 @@ def fail(where: object, problem: str, fix: str) -> NoReturn:
     raise CampaignError(f"{where}: {problem}; {fix}.")
 
 
-def excitation_of(names: Sequence[str], where: object) -> Excitation:
-    """Check a record's column names and return its excitation, 'base', 'force' or 'voltage'.
+def excitation_of(names: Sequence[str], where: object, *, expected: Excitation | None = None,
+                  noun: str = "column", others_ok: bool = False) -> Excitation:
+    """Check a record's channel names and return its excitation, 'base', 'force' or 'voltage'.
 
     Parameters
     ----------
     names : sequence of str
-        Column (or MAT variable) names of the record.
+        Every column (or MAT variable) name of the record, as the file has them.
     where : object
         The file, named in the message.
+    expected : {'base', 'force', 'voltage'}, optional
+        The excitation the manifest's level column gives the run: a missing reference
+        is then named as that kind's channel.
+    noun : str, optional
+        What the file calls a channel ('column', 'variable'), used in the message.
+    others_ok : bool, optional
+        True when names other than the contract's are ignored (MAT files may hold more
+        variables); they are still listed in the message.
 
     Raises
     ------
     CampaignError
-        Unless the names are exactly ``time_s``, one of ``base_accel_g`` /
-        ``force_lbf`` / ``drive_V``, and one of ``response_accel_g`` /
-        ``response_accel_m_s2`` (in any order).
+        Unless the names hold ``time_s``, one of ``base_accel_g`` / ``force_lbf`` /
+        ``drive_V``, and one of ``response_accel_g`` / ``response_accel_m_s2``, and
+        (unless `others_ok`) nothing else; in any order.
     """
     names = [str(n) for n in names]
     kinds = [k for k, c in REFERENCE.items() if c in names]
-    kind: Excitation = kinds[0] if len(kinds) == 1 else "base"
+    kind: Excitation = kinds[0] if len(kinds) == 1 else (expected or "base")
     response = RESPONSE_SI if RESPONSE_SI in names and RESPONSE not in names else RESPONSE
     want = [TIME, REFERENCE[kind], response]
-    fix = f"export the three columns {','.join(want)}"
-    found = f"(found: {', '.join(names)})"
+    verb = "save the MAT variables" if noun == "variable" else f"export the three {noun}s"
+    fix = f"{verb} {','.join(want)}"
+    found = f"(the file's {noun}s: {', '.join(names)})" if names else f"(the file has no {noun}s)"
     if len(kinds) >= 2:
         fail(where, f"it has {len(kinds)} reference channels {' and '.join(REFERENCE[k] for k in kinds)} {found}",
              "keep the one reference channel of the test (base acceleration, force or drive voltage)")
     missing = [c for c in want if c not in names]
     if missing:
-        also = " (or 'force_lbf' / 'drive_V' for a force- / voltage-driven run)" if missing[0] == REFERENCE["base"] else ""
+        also = ""
+        if missing[0] == REFERENCE[kind] and expected is None:
+            also = " (or 'force_lbf' / 'drive_V' for a force- / voltage-driven run)"
+        elif missing[0] == REFERENCE[kind]:
+            also = f" (the manifest's {LEVEL[kind]} makes the run {kind}-driven)"
         si = " (or 'response_accel_m_s2' for a response in m/s^2)" if missing[0] == RESPONSE else ""
-        fail(where, f"column '{missing[0]}'{also} is missing{si} {found}", fix)
+        fail(where, f"{noun} '{missing[0]}'{also} is missing{si} {found}", fix)
     extra = [c for c in names if c not in want]
-    if extra:
-        fail(where, f"unexpected column(s) {', '.join(extra)} {found}", fix)
+    if extra and not others_ok:
+        fail(where, f"unexpected {noun}(s) {', '.join(extra)} {found}", fix)
     return kind

@@ -5,16 +5,16 @@ A campaign folder holds ``manifest.csv`` (one row per run) and one record per ru
 ``base_accel_g`` (g) or, for force-driven tests, ``force_lbf`` (lbf), or, for a
 shaker driven open-loop, ``drive_V`` (amplifier voltage, V), and ``response_accel_g``
 (g) or ``response_accel_m_s2`` (m/s^2, converted to g on read); 1 g = 386.089 in/s^2
-= 9.80665 m/s^2. ``raw_data/README.md`` states the
-contract for people; every violation raises `CampaignError` with one sentence that
-names the file, the problem and the fix. File I/O of the package lives here (the
-checks and writers are in private helper modules and re-exported).
+= 9.80665 m/s^2. A record may also be a lab's own export (UFF 58, NI TDMS, Test.Lab
+MATLAB; `jointcal._lab_formats`) whose channels the manifest names. ``raw_data/README.md``
+states the contract for people; every violation raises `CampaignError` with one sentence
+that names the file, the problem and the fix. File I/O of the package lives here (the
+manifest reader, the checks and the writers are in private helper modules and re-exported).
 """
 from __future__ import annotations
 
-import gzip
 import os
-import re
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -26,9 +26,11 @@ from numpy.typing import NDArray
 from jointcal._atomic import write_bytes_atomic, write_csv_atomic, write_json_atomic, write_run
 from jointcal._checks import validate_run
 from jointcal._contract import (
-    G_SI, LEVEL, POSITIVE, REFERENCE, RESPONSE, RESPONSE_SI, TEXT, TIME, CampaignError, CampaignWarning,
-    OnDataProblem, excitation_of, fail,
+    CHANNEL_COLUMNS, G_SI, LEVEL, REFERENCE, RESPONSE, RESPONSE_SI, START, TIME, CampaignError, CampaignWarning,
+    Excitation, OnDataProblem, excitation_of, fail,
 )
+from jointcal._lab_formats import LAB_SUFFIXES, is_testlab, read_lab_export
+from jointcal._manifest import check_csv_text, read_manifest
 
 __all__ = [
     "CampaignError", "CampaignWarning", "read_manifest", "read_run", "validate_run",
@@ -37,139 +39,8 @@ __all__ = [
 ]
 
 
-def read_manifest(path: str | os.PathLike[str]) -> pd.DataFrame:
-    """Read and validate a campaign's ``manifest.csv``.
-
-    Parameters
-    ----------
-    path : path-like
-        The manifest file. Columns: ``run_id``, ``assembly``, ``sequence`` (order of
-        the run within its assembly, integer >= 1), ``level_g`` (base acceleration
-        amplitude, g), ``level_lbf`` (force amplitude, lbf) or ``level_V`` (drive
-        voltage amplitude, V), ``direction``
-        (``up``/``down``), ``f_start_hz``, ``f_stop_hz`` (Hz),
-        ``sweep_rate_hz_per_s`` (Hz/s), ``sample_rate_hz`` (Hz) and ``file`` (relative
-        to the manifest's folder). Extra columns are kept.
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per run in file order; numbers as float64 (``sequence`` int64),
-        text stripped, ``direction`` lower-case.
-
-    Raises
-    ------
-    CampaignError
-        Missing file or column, empty or non-numeric cell, non-positive rate or
-        frequency, band inconsistent with the direction or above Nyquist, or a
-        duplicated ``run_id``, ``file`` or (``assembly``, ``sequence``).
-    """
-    path = Path(path)
-    if not path.is_file():
-        fail(path, "the manifest does not exist", "put manifest.csv (one row per run) in the campaign folder")
-    _check_delimiter(path)
-    try:
-        raw = pd.read_csv(path, dtype=str, keep_default_na=False, encoding="utf-8-sig")
-    except (ValueError, UnicodeDecodeError) as exc:
-        fail(path, f"cannot be read as CSV ({exc})", "save it as comma-separated UTF-8 text with one header line")
-    raw.columns = [str(c).strip() for c in raw.columns]
-    levels = [c for c in LEVEL.values() if c in raw.columns]
-    if len(levels) != 1:
-        found = " and ".join(levels) or "neither"
-        fail(path, f"it needs exactly one of the columns {', '.join(LEVEL.values())} (found {found})",
-             "give level_g for base-driven, level_lbf for force-driven or level_V for voltage-driven campaigns")
-    need = ["run_id", "assembly", "sequence", levels[0], "direction", *POSITIVE, "file"]
-    missing = [c for c in need if c not in raw.columns]
-    if missing:
-        fail(path, f"column(s) {', '.join(missing)} missing (found: {', '.join(raw.columns)})",
-             f"use the header {','.join(need)}")
-    if raw.empty:
-        fail(path, "it lists no runs", "add one row per run")
-    rows = [_manifest_row(rec, path, i + 2, levels[0]) for i, rec in enumerate(raw.to_dict("records"))]
-    for i, rec in enumerate(rows):
-        _check_name(rec, path, i + 2)
-    df = pd.DataFrame(rows, columns=need + [c for c in raw.columns if c not in need])
-    for keys in (["run_id"], ["file"], ["assembly", "sequence"]):
-        dup = df.duplicated(keys, keep=False)
-        if dup.any():
-            first = df.loc[dup].iloc[0]
-            same = dup & (df[keys] == first[keys]).all(axis=1)
-            lines = ", ".join(str(i + 2) for i in np.flatnonzero(same))
-            what = " ".join(f"{k} {first[k]!r}" if k != "sequence" else f"sequence {first[k]} of"
-                            for k in reversed(keys))
-            fail(path, f"lines {lines} repeat {what}", f"make each {' within '.join(reversed(keys))} unique")
-    return df
-
-
-DELIMITERS = {";": "semicolons", "\t": "tabs", "|": "vertical bars"}
-SAFE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._+-]*")  # a file name on every system, not a path
-
-
-def _check_delimiter(path: Path) -> None:
-    """Fail, naming the separator, when a CSV file's header is not split by commas."""
-    try:
-        with (gzip.open(path, "rt", encoding="utf-8-sig") if path.name.lower().endswith(".gz")
-              else open(path, encoding="utf-8-sig")) as fh:
-            head = fh.readline()
-    except (OSError, EOFError, UnicodeDecodeError):
-        return  # pandas' reader names the problem
-    if "," not in head:
-        for sep, name in DELIMITERS.items():
-            if head.count(sep) >= 2:
-                fail(path, f"its columns are separated by {name} ({sep!r}), not commas (header: {head.strip()!r})",
-                     "save it as comma-separated text with '.' as the decimal point")
-
-
-def _check_name(rec: dict[str, Any], path: Path, line: int) -> None:
-    """Fail unless run_id is a safe file name and assembly holds no path separator."""
-    rid, assembly = rec["run_id"], rec["assembly"]
-    where = f"{path}: line {line} (run_id {rid!r})"
-    if not SAFE_NAME.fullmatch(rid):
-        bad = sorted({c for c in rid if not re.fullmatch(r"[A-Za-z0-9._+-]", c)}) or [rid[0]]
-        fail(where, f"run_id {rid!r} is not a safe file name (it names the run's output files; "
-             f"{', '.join(map(repr, bad))} not allowed there)",
-             "use letters, digits, '.', '_', '+' and '-' only, starting with a letter or digit")
-    if any(c in assembly for c in "/\\") or assembly.startswith("."):
-        fail(where, f"assembly {assembly!r} is not a safe folder name (it names the calibration's output folder)",
-             "write it without '/' or '\\' and not starting with '.'")
-
-
-def _manifest_row(rec: dict[str, str], path: Path, line: int, level: str) -> dict[str, Any]:
-    where = f"{path}: line {line} (run_id {rec['run_id'].strip()!r})"
-    out: dict[str, Any] = {k: v.strip() for k, v in rec.items()}
-    for col in (*TEXT, "sequence", level, *POSITIVE):
-        if not out[col]:
-            fail(where, f"{col} is empty", f"fill in {col}")
-    try:
-        out["sequence"] = int(out["sequence"])
-    except ValueError:
-        out["sequence"] = 0
-    if out["sequence"] < 1:
-        fail(where, f"sequence {rec['sequence'].strip()!r} is not an integer >= 1",
-             "number the runs of each assembly 1, 2, 3, ... in test order")
-    for col in (level, *POSITIVE):
-        try:
-            out[col] = float(out[col])
-        except ValueError:
-            out[col] = float("nan")
-        if not (np.isfinite(out[col]) and out[col] > 0):
-            fail(where, f"{col} {rec[col].strip()!r} is not a positive number", f"write {col} as a number > 0")
-    out["direction"] = out["direction"].lower()
-    f0, f1, fs = out["f_start_hz"], out["f_stop_hz"], out["sample_rate_hz"]
-    if out["direction"] not in ("up", "down"):
-        fail(where, f"direction {rec['direction'].strip()!r} is not up or down", "write up or down")
-    if (out["direction"] == "up") != (f0 < f1) or f0 == f1:
-        sweep = "an up" if out["direction"] == "up" else "a down"
-        fail(where, f"{sweep} sweep cannot go from {f0:g} Hz to {f1:g} Hz",
-             "use f_start_hz < f_stop_hz for up and f_start_hz > f_stop_hz for down")
-    if max(f0, f1) >= fs / 2:
-        fail(where, f"the band reaches {max(f0, f1):g} Hz, above Nyquist ({fs / 2:g} Hz)",
-             "check the band and sample_rate_hz")
-    return out
-
-
-def read_run(path: str | os.PathLike[str]) -> pd.DataFrame:
-    """Read one run record (``.csv``, ``.csv.gz`` or MATLAB ``.mat``).
+def read_run(path: str | os.PathLike[str], row: Mapping[str, Any] | None = None) -> pd.DataFrame:
+    """Read one run record: the contract's CSV or MAT file, or a lab's own export.
 
     Parameters
     ----------
@@ -179,40 +50,90 @@ def read_run(path: str | os.PathLike[str]) -> pd.DataFrame:
         ``time_s,drive_V,response_accel_g``; a response in m/s^2 is declared by naming
         its column ``response_accel_m_s2``), gzip-compressed CSV, or a MATLAB v5/v7
         file holding variables of those names as row or column vectors (other
-        variables are ignored).
+        variables are ignored); or a lab's export (`jointcal._lab_formats`): UFF 58
+        (``.uff``, ``.unv``), NI TDMS (``.tdms``) or a Simcenter Test.Lab MATLAB export
+        (``.mat`` holding structs with ``x_values`` and ``y_values``).
+    row : mapping, optional
+        The run's manifest row (`read_manifest`; a row of runs.csv will do). Its level
+        column gives the excitation; its ``sweep_start_s`` (s) drops the samples before
+        the sweep; its ``reference_channel`` and ``response_channel`` name a lab
+        export's channels (required for those formats).
 
     Returns
     -------
     pandas.DataFrame
         Columns ``time_s`` (s), ``base_accel_g`` (g), ``force_lbf`` (lbf) or
         ``drive_V`` (V), and ``response_accel_g`` (g; converted from m/s^2 when so
-        declared), all float64, shape (n, 3). Empty cells become NaN.
+        declared, or from the unit a lab export gives), all float64, shape (n, 3).
+        Empty cells become NaN. ``attrs['sources']`` maps each column to the file's
+        name for it, its declared unit and how it was declared ('name', 'file' or
+        'none'); ``attrs['format']`` names the format.
 
     Raises
     ------
     CampaignError
-        Unsupported suffix, unreadable file, wrong columns, non-numeric values or
-        vectors of different lengths.
+        Unsupported suffix, unreadable file, wrong columns, non-numeric values,
+        vectors of different lengths, a lab export's channel that is not named or not
+        in the file, or a unit that is not the quantity of the channel's role.
     """
     path = Path(path)
     name = path.name.lower()
+    kind = _row_excitation(row)
+    channels = {role: _cell(row, col) for role, col in CHANNEL_COLUMNS.items()} if row is not None else {}
     if name.endswith(".mat"):
-        cols = _read_mat(path)
+        cols, attrs = _read_mat(path, kind, channels, row)
     elif name.endswith((".csv", ".csv.gz")):
-        cols = _read_csv(path)
+        cols, attrs = _read_csv(path, kind)
+    elif name.endswith(LAB_SUFFIXES):
+        cols, attrs = read_lab_export(path, kind, channels, _cell(row, "run_id"))
     else:
-        fail(path, "unsupported file type", "store runs as .csv, .csv.gz or .mat")
-    return pd.DataFrame(cols)
+        fail(path, "unsupported file type",
+             f"store runs as .csv, .csv.gz or .mat, or as a lab export ({', '.join(LAB_SUFFIXES)})")
+    if any(channels.values()) and attrs["format"] in ("CSV", "MAT"):
+        fail(path, f"the manifest names channels ({', '.join(c for c in channels.values() if c)}) for a "
+             f"{attrs['format']} record, whose {'column' if attrs['format'] == 'CSV' else 'variable'} names are "
+             "the contract's", "leave reference_channel and response_channel empty for this run")
+    df = pd.DataFrame(cols)
+    df.attrs.update(attrs)
+    return _from_sweep_start(df, row, path)
 
 
-def _read_csv(path: Path) -> dict[str, NDArray[np.float64]]:
-    _check_delimiter(path)
+def _cell(row: Mapping[str, Any] | None, col: str) -> str | None:
+    """A text cell of a manifest row, None when absent or empty (NaN in a runs.csv read back)."""
+    value = None if row is None else row.get(col)
+    if isinstance(value, float) and value.is_integer():  # a numeric name read back from runs.csv
+        value = str(int(value))
+    return None if value is None or (isinstance(value, float) and np.isnan(value)) or not str(value).strip() \
+        else str(value).strip()
+
+
+def _row_excitation(row: Mapping[str, Any] | None) -> Excitation | None:
+    """The excitation the row's level column gives, None without a row."""
+    return None if row is None else next((k for k, c in LEVEL.items() if _cell(row, c) is not None), None)
+
+
+def _from_sweep_start(df: pd.DataFrame, row: Mapping[str, Any] | None, path: Path) -> pd.DataFrame:
+    """Drop the samples before the row's ``sweep_start_s`` (a pre-trigger head)."""
+    start = float(_cell(row, START) or 0.0)
+    if start <= 0:
+        return df
+    i0 = int(round(start * float(row["sample_rate_hz"])))
+    if i0 > len(df) - 16:
+        fail(path, f"{START} = {start:g} s is past the record's end ({len(df)} samples)",
+             f"give the sweep's start in seconds after the record's first sample in {START}")
+    out = df.iloc[i0:].reset_index(drop=True)
+    out.attrs.update(df.attrs)
+    return out
+
+
+def _read_csv(path: Path, kind: Excitation | None) -> tuple[dict[str, NDArray[np.float64]], dict[str, Any]]:
+    check_csv_text(path)
     try:
         df = pd.read_csv(path, skipinitialspace=True)
     except (OSError, EOFError, ValueError, UnicodeDecodeError) as exc:
         fail(path, f"cannot be read as CSV ({exc})", "re-export it as comma-separated text with one header line")
     df.columns = [str(c).strip() for c in df.columns]
-    kind = excitation_of(list(df.columns), path)
+    kind = excitation_of(list(df.columns), path, expected=kind)
     out = {}
     for col in (TIME, REFERENCE[kind], _response_name(df.columns)):
         values = pd.to_numeric(df[col], errors="coerce")
@@ -222,7 +143,7 @@ def _read_csv(path: Path) -> dict[str, NDArray[np.float64]]:
             fail(path, f"column '{col}' has the non-numeric value {df[col].iloc[i]!r} on line {i + 2}",
                  "export plain numbers")
         out[col] = values.to_numpy(np.float64)
-    return _in_g(out)
+    return _in_g(out, "CSV")
 
 
 def _response_name(names) -> str:
@@ -230,14 +151,20 @@ def _response_name(names) -> str:
     return RESPONSE_SI if RESPONSE_SI in names and RESPONSE not in names else RESPONSE
 
 
-def _in_g(cols: dict[str, NDArray[np.float64]]) -> dict[str, NDArray[np.float64]]:
-    """Rename a response declared in m/s^2 to ``response_accel_g``, converted to g."""
+def _in_g(cols: dict[str, NDArray[np.float64]], fmt: str) -> tuple[dict[str, NDArray[np.float64]], dict[str, Any]]:
+    """Rename a response declared in m/s^2 to ``response_accel_g``, converted to g; the sources (see `read_run`)."""
+    units = {TIME: "s", RESPONSE: "g", RESPONSE_SI: "m/s^2", REFERENCE["base"]: "g", REFERENCE["force"]: "lbf",
+             REFERENCE["voltage"]: "V"}
+    noun = "column" if fmt == "CSV" else "variable"
+    sources = {(RESPONSE if k == RESPONSE_SI else k): {"name": k, "unit": units[k], "by": "name", "noun": noun}
+               for k in cols}
     if RESPONSE_SI in cols:
-        return {(RESPONSE if k == RESPONSE_SI else k): (v / G_SI if k == RESPONSE_SI else v) for k, v in cols.items()}
-    return cols
+        cols = {(RESPONSE if k == RESPONSE_SI else k): (v / G_SI if k == RESPONSE_SI else v) for k, v in cols.items()}
+    return cols, {"format": fmt, "sources": sources}
 
 
-def _read_mat(path: Path) -> dict[str, NDArray[np.float64]]:
+def _read_mat(path: Path, kind: Excitation | None, channels: dict[str, str | None],
+              row: Mapping[str, Any] | None) -> tuple[dict[str, NDArray[np.float64]], dict[str, Any]]:
     try:
         mat = scipy.io.loadmat(path)
     except NotImplementedError:
@@ -245,7 +172,9 @@ def _read_mat(path: Path) -> dict[str, NDArray[np.float64]]:
     except (OSError, ValueError, TypeError) as exc:
         fail(path, f"cannot be read as a MATLAB file ({exc})", "save it with MATLAB's save(..., '-v7')")
     names = [k for k in mat if not k.startswith("__")]
-    kind = excitation_of([n for n in names if n in (TIME, RESPONSE, RESPONSE_SI, *REFERENCE.values())], path)
+    if is_testlab(mat):
+        return read_lab_export(path, kind, channels, _cell(row, "run_id"))
+    kind = excitation_of(names, path, expected=kind, noun="variable", others_ok=True)
     out = {}
     for var in (TIME, REFERENCE[kind], _response_name(names)):
         a = np.asarray(mat[var])
@@ -256,7 +185,7 @@ def _read_mat(path: Path) -> dict[str, NDArray[np.float64]]:
     lengths = {len(v) for v in out.values()}
     if len(lengths) != 1:
         fail(path, f"variables have different lengths {sorted(lengths)}", "save the three channels with one length")
-    return _in_g(out)
+    return _in_g(out, "MAT")
 
 
 def ingest_campaign(campaign_dir: str | os.PathLike[str], *,
@@ -285,11 +214,8 @@ def ingest_campaign(campaign_dir: str | os.PathLike[str], *,
     manifest = read_manifest(campaign_dir / "manifest.csv")
     rows = []
     for _, row in manifest.iterrows():
-        path = campaign_dir / row["file"]
-        if not path.is_file():
-            fail(path, f"the file of run {row['run_id']!r} listed in manifest.csv does not exist",
-                 "add the file or correct its name in the manifest's file column")
-        checks = validate_run(read_run(path), row, path, on_data_problem=on_data_problem)
+        path = campaign_dir / row["file"]  # read_manifest checked that it exists
+        checks = validate_run(read_run(path, row), row, path, on_data_problem=on_data_problem)
         checks["flags"] = ";".join(checks["flags"])
         rows.append({**row.to_dict(), **checks})
     return pd.DataFrame(rows)

@@ -62,8 +62,8 @@ def main() -> None:
         n_runs += len(runs)
         for row in read_manifest(camp / "manifest.csv").to_dict("records"):
             x = read_run(camp / row["file"])["base_accel_g"].to_numpy()
-            sweep_s = abs(row["f_stop_hz"] - row["f_start_hz"]) / row["sweep_rate_hz_per_s"]
-            amp = window_amplitudes(x, row["sample_rate_hz"], sweep_s, min(row["f_start_hz"], row["f_stop_hz"]))
+            amp = window_amplitudes(x, row["sample_rate_hz"], row["f_start_hz"], row["f_stop_hz"],
+                                    row["sweep_rate_hz_per_s"])
             ratios.append(np.median(amp) / row["level_g"])
     ratios = np.array(ratios)
     print(f"false positives: {n_flag} flagged of {n_runs} clean runs (raw_data + small campaign)")

@@ -2,11 +2,13 @@
 import csv
 import os
 import sys
+import warnings
 from pathlib import Path
 
 from snakemake.utils import validate
 
 from jointcal._workflow import config_problem, stage_hash
+from jointcal.io import CampaignError, CampaignWarning, read_manifest, write_bytes_atomic
 
 # Config: an unknown key (a typo) is one line naming the nearest valid key, before the schema's own
 # validation (whose message is a dump of the schema); nested --config values given as text are converted.
@@ -38,25 +40,51 @@ if not MANIFEST.is_file():
     )
 
 
-def campaign_files(wildcards):
-    """The manifest and every run file it lists (validation itself is jointcal.io's job)."""
-    with open(MANIFEST, newline="", encoding="utf-8-sig") as fh:
-        listed = [(r.get("file") or "").strip() for r in csv.DictReader(fh)]
-    return {"manifest": str(MANIFEST), "runs": [str(RAW_DATA / f) for f in listed if f]}
-
-
 def _manifest_rows():
+    """The manifest's rows as text, read leniently at parse time (a workflow of the later stages only,
+    started from their tables, may hold a manifest of run_id, assembly and file alone)."""
     with open(MANIFEST, newline="", encoding="utf-8-sig") as fh:
-        return [{k.strip(): (v or "").strip() for k, v in r.items()} for r in csv.DictReader(fh)]
+        return [{(k or "").strip(): (v or "").strip() for k, v in r.items()} for r in csv.DictReader(fh)]
 
 
-RUN_FILES = {r["run_id"]: str(RAW_DATA / r["file"]) for r in _manifest_rows() if r.get("run_id")}
+RUN_FILES = {r["run_id"]: str(RAW_DATA / r.get("file", "")) for r in _manifest_rows() if r.get("run_id")}
 RUN_IDS = list(RUN_FILES)
 ASSEMBLIES = list(dict.fromkeys(r["assembly"] for r in _manifest_rows() if r.get("assembly")))
+_CHECKED = []
+
+
+def checked_campaign():
+    """Read and check the manifest once, with jointcal.io.read_manifest, in the input function of every rule
+    that reads raw records: a Windows path, a listed file that is missing or any other manifest problem
+    stops the workflow there with the one-sentence message on stderr and in the ingest log, before
+    Snakemake looks for the records (its MissingInputException names no fix). Notes on the manifest
+    (empty trailing rows) are left to the ingest stage's log."""
+    if not _CHECKED:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", CampaignWarning)
+                _CHECKED.append(read_manifest(MANIFEST))
+        except CampaignError as exc:
+            write_bytes_atomic(f"jointcal: {exc}\n".encode(), RESULTS / "logs" / "ingest.log")
+            sys.exit(f"jointcal: {exc}")
+    return _CHECKED[0]
+
+
+def campaign_files(wildcards):
+    """The manifest and every run file it lists, once the manifest is checked (checked_campaign)."""
+    checked_campaign()
+    return {"manifest": str(MANIFEST), "runs": list(RUN_FILES.values())}
+
+
+def campaign_records(wildcards):
+    """Every run file the manifest lists, once the manifest is checked."""
+    checked_campaign()
+    return list(RUN_FILES.values())
 
 
 def run_record(wildcards):
-    """The raw record of one run."""
+    """The raw record of one run, once the manifest is checked."""
+    checked_campaign()
     return RUN_FILES[wildcards.run_id]
 
 
@@ -72,8 +100,9 @@ def ingest_table(wildcards):
 
 
 def assembly_records(wildcards):
-    """The raw records of one assembly's runs."""
-    return [str(RAW_DATA / r["file"]) for r in _manifest_rows() if r.get("assembly") == wildcards.assembly]
+    """The raw records of one assembly's runs, once the manifest is checked."""
+    table = checked_campaign()
+    return [RUN_FILES[rid] for rid, asm in zip(table["run_id"], table["assembly"]) if asm == wildcards.assembly]
 
 
 def remove_stale_outputs():

@@ -5,7 +5,7 @@ rule modal_properties:
         runs=RESULTS / "ingest" / "runs.csv",
         env=expand(RESULTS / "envelopes" / "{run_id}.csv", run_id=RUN_IDS),
         meta=expand(RESULTS / "envelopes" / "{run_id}.json", run_id=RUN_IDS),
-        records=list(RUN_FILES.values()),
+        records=campaign_records,
     output:
         table=RESULTS / "modal" / "modal_properties.csv",
         scatter=RESULTS / "modal" / "scatter.csv",
@@ -26,7 +26,7 @@ rule modal_figures:
         table=RESULTS / "modal" / "modal_properties.csv",
         runs=RESULTS / "ingest" / "runs.csv",
         env=expand(RESULTS / "envelopes" / "{run_id}.csv", run_id=RUN_IDS),
-        records=list(RUN_FILES.values()),
+        records=campaign_records,
     output:
         envelopes=report(RESULTS / "figures" / "fig3_5_envelopes.png",
                          caption="../report/fig3_5_envelopes.rst", category="1. Modal properties"),

@@ -38,7 +38,7 @@ def main(smk) -> None:
         env_dir = Path(smk.input.env[0]).parent
         envs = {r["run_id"]: pd.read_csv(env_dir / f"{r['run_id']}.csv") for r in rows
                 if (env_dir / f"{r['run_id']}.csv").is_file()}
-        records = [read_run(listed_record(str(r["file"]), list(smk.input.records))) for r in rows]
+        records = [read_run(listed_record(str(r["file"]), list(smk.input.records)), r) for r in rows]
         best = json.loads(Path(smk.input.best).read_text())
         summary = json.loads(Path(smk.input.validation).read_text())
         space = CalibrateSettings.from_config(smk.params.calibrate).space

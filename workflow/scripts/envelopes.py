@@ -16,7 +16,7 @@ from jointcal.signal import envelopes, meta_dict
 def main(smk) -> None:
     runs = pd.read_csv(smk.input.runs, dtype={"flags": str}).set_index("run_id", drop=False)
     row = runs.loc[smk.wildcards.run_id].to_dict()
-    record = read_run(smk.input.record)
+    record = read_run(smk.input.record, row)
     try:
         env, meta = envelopes(record, row, **smk.params.envelopes)
         meta = {**meta_dict(meta), "error": ""}

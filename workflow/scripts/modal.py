@@ -31,7 +31,7 @@ def main(smk) -> None:
         env = pd.read_csv(env_dir / f"{rid}.csv")
         ingest_flags = [f for f in str(row.get("flags") or "").split(";") if f and f != "nan"]
         path = listed_record(str(row["file"]), records)  # whole relative path: basenames may repeat
-        record = read_run(path) if path else None
+        record = read_run(path, row) if path else None
         if meta.get("error") and record is None:
             out = {k: row.get(k) for k in ("run_id", "assembly", "sequence", "direction")}
             out["flags"] = ";".join(ingest_flags + ["unusable"])

@@ -20,7 +20,7 @@ def main(smk) -> None:
     lo = min(row["f_start_hz"], row["f_stop_hz"])
     n = window_length(row["sample_rate_hz"], row["sweep_rate_hz_per_s"], lo, **{
         k: v for k, v in smk.params.envelopes.items() if k == "zeta_min"})
-    record = read_run(listed_record(row["file"], list(smk.input.records)))  # whole path: basenames may repeat
+    record = read_run(listed_record(row["file"], list(smk.input.records)), row)  # whole path: basenames may repeat
     plot_spectrogram(record, envs[rid], row["sample_rate_hz"], n, rid, smk.output.spectrogram)
     Path(smk.log[0]).write_text(f"jointcal: figures written; spectrogram of {rid}\n")
 

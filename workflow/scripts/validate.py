@@ -27,7 +27,7 @@ def main(smk) -> None:
         best = json.loads(Path(smk.input.best).read_text())
         runs = pd.read_csv(smk.input.runs, dtype={"flags": str})
         rows = runs[runs["assembly"] == asm].to_dict("records")
-        records = [read_run(listed_record(str(r["file"]), list(smk.input.records))) for r in rows]
+        records = [read_run(listed_record(str(r["file"]), list(smk.input.records)), r) for r in rows]
         modal = pd.read_csv(smk.input.modal).set_index("run_id")
         f_res = {r["run_id"]: float(modal.loc[r["run_id"], "f_res_hz"]) for r in rows if r["run_id"] in modal.index}
         f_ref = float(np.nanmedian(list(f_res.values()))) if f_res else None

@@ -1,0 +1,410 @@
+"""Lab mistakes: each bad input, built from a clean run of the example campaign (raw_data/) or of a
+synthetic voltage-driven campaign, gets one sentence naming the file, the problem and the fix; a run
+that is still readable is flagged and the others go on, otherwise nothing is written.
+
+What is left in the results folder is checked through `jointcal ingest CAMPAIGN RESULTS/ingest/runs.csv
+--on-data-problem flag` (the workflow's policy; its ingest rule runs the same `ingest_campaign`), and
+through the workflow itself where the workflow adds something (the parse-time manifest check, the
+modal stage's 'unusable').
+"""
+from __future__ import annotations
+
+import subprocess
+import sys
+import warnings
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import scipy.io
+from _campaign import REPO, edit_manifest, edit_run, example_copy, workflow_copy
+
+from jointcal._amplitudes import low_frequency_ratio
+from jointcal._checks import _check_time, time_resolution
+from jointcal.cli import main
+from jointcal.io import CampaignError, CampaignWarning, ingest_campaign, read_manifest, read_run, validate_run
+
+G_SI = 9.80665  # m/s^2 per g
+RUN, OTHER = "first_01_1g_up", "first_07_2g_up"  # a 1 g up sweep and a 2 g one, from raw_data/
+FILE = f"runs/{RUN}.csv.gz"
+
+
+@pytest.fixture
+def example(tmp_path: Path) -> Path:
+    """Two clean runs of the example campaign, to break the first."""
+    return example_copy(tmp_path / "campaign", RUN, OTHER)
+
+
+def _one_sentence(msg: str, *words: str) -> None:
+    assert all(w in msg for w in words), msg
+    assert "\n" not in msg and msg.endswith((".", "?")), msg
+
+
+def _ingest(campaign: Path, capsys) -> tuple[int, str, pd.DataFrame | None]:
+    """Exit status, stderr and runs.csv (None when not written) of `jointcal ingest` into a results folder."""
+    out = campaign.parent / "results" / "ingest" / "runs.csv"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", CampaignWarning)  # the CLI prints them
+        code = main(["ingest", str(campaign), str(out), "--on-data-problem", "flag"])
+    err = capsys.readouterr().err
+    return code, err, (pd.read_csv(out, keep_default_na=False).set_index("run_id") if out.exists() else None)
+
+
+def _flagged(campaign: Path, capsys, rid: str, flag: str, *words: str) -> pd.DataFrame:
+    """The run gets `flag` and a warning naming `words`; the other runs are clean; runs.csv is written."""
+    code, err, runs = _ingest(campaign, capsys)
+    assert code == 0 and runs is not None, err
+    warned = [line.removeprefix("jointcal: warning: ") for line in err.splitlines() if "warning" in line]
+    assert len(warned) == 1, err
+    _one_sentence(warned[0], *words)
+    assert runs.loc[rid, "flags"].split(";") == [flag]
+    assert (runs.drop(index=rid)["flags"] == "").all()
+    return runs
+
+
+def _stopped(campaign: Path, capsys, *words: str) -> str:
+    """Ingest stops with one sentence naming `words`; no runs.csv is left."""
+    code, err, runs = _ingest(campaign, capsys)
+    lines = err.strip().splitlines()
+    assert code == 2 and runs is None, err
+    assert len(lines) == 1 and lines[0].startswith("jointcal: ") and "Traceback" not in err, err
+    _one_sentence(lines[0], *words)
+    return lines[0]
+
+
+def _scale(col: str, factor: float):
+    def edit(d: pd.DataFrame) -> None:
+        d[col] = d[col] * factor
+    return edit
+
+
+# ------------------------------------------------------------------------ the response's units, base-driven
+
+
+@pytest.mark.parametrize("mistake, words", [
+    ("m/s^2 named g", ["is it in m/s^2?", "name the column response_accel_m_s2 (it holds m/s^2)"]),
+    ("g named m/s^2", ["read from 'response_accel_m_s2' as m/s^2", "is it in g?",
+                       "name the column response_accel_g (it holds g)"]),
+])
+def test_a_base_driven_response_in_other_units_is_flagged(example, capsys, mistake, words):
+    """Below resonance a base-driven response follows its base: 9.8 or 0.1 times it is a units mistake."""
+    if mistake == "m/s^2 named g":
+        edit_run(example, FILE, _scale("response_accel_g", G_SI))
+    else:  # g values under the m/s^2 name (converted once more on read)
+        edit_run(example, FILE, lambda d: d.rename(columns={"response_accel_g": "response_accel_m_s2"}))
+    _flagged(example, capsys, RUN, "units:response_accel_g", f"{FILE}: below resonance (at 713 Hz", *words,
+             f"or remove run '{RUN}' from manifest.csv")
+
+
+def test_a_base_in_m_s2_beside_a_right_m_s2_response_converts_only_the_base(example, capsys):
+    """The response, declared m/s^2 and in m/s^2, is right: the fix converts the base alone."""
+    def edit(d: pd.DataFrame) -> pd.DataFrame:
+        return pd.DataFrame({"time_s": d["time_s"], "base_accel_g": d["base_accel_g"] * G_SI,
+                             "response_accel_m_s2": d["response_accel_g"] * G_SI})
+    edit_run(example, FILE, edit)
+    runs = _flagged(example, capsys, RUN, "level:base_accel_g", FILE, "is base_accel_g in m/s^2?",
+                    "so the response's own unit is right", "export base_accel_g in g (divide by 9.80665)",
+                    "leave the response as it is")
+    assert "export base_accel_g and response_accel_g" not in capsys.readouterr().err
+    assert runs.loc[OTHER, "flags"] == ""
+
+
+def test_both_channels_in_m_s2_are_converted_together(example):
+    edit_run(example, FILE, lambda d: d.assign(base_accel_g=d["base_accel_g"] * G_SI,
+                                               response_accel_g=d["response_accel_g"] * G_SI))
+    with pytest.raises(CampaignError) as info:
+        ingest_campaign(example)
+    _one_sentence(str(info.value), FILE, "is the record in m/s^2?",
+                  "export base_accel_g and response_accel_g in g (divide by 9.80665)")
+
+
+def test_units_check_has_no_false_positive_on_the_example_runs():
+    """All 24 runs: the response/base ratio at the band's bottom, over a single mode's rise, is 1 within 2%."""
+    man = read_manifest(REPO / "raw_data" / "manifest.csv")
+    for row in man.to_dict("records"):
+        df = read_run(REPO / "raw_data" / row["file"], row)
+        f_low, ratio, f_peak = low_frequency_ratio(df["base_accel_g"].to_numpy(), df["response_accel_g"].to_numpy(),
+                                                   row["sample_rate_hz"], row["f_start_hz"], row["f_stop_hz"],
+                                                   row["sweep_rate_hz_per_s"])
+        assert ratio * (1 - (f_low / f_peak) ** 2) == pytest.approx(1.0, abs=0.02), row["run_id"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert (ingest_campaign(REPO / "raw_data")["flags"] == "").all()
+
+
+EFFECT_CASES = [(e, {}) for e in ("none", "fixture_flexibility", "channel_delay", "cubic_stiffening",
+                                  "joint_settling", "quadratic_damping", "sensor_gain", "contact_spring")]
+EFFECT_CASES.append(("fixture_flexibility", {"m_can_ratio": 2.0, "f_can_hz": 3200.0}))  # a soft fixture
+
+
+@pytest.mark.parametrize("effect, params", EFFECT_CASES)
+def test_units_check_has_no_false_positive_on_synthetic_campaigns(tmp_path, effect, params):
+    """`jointcal synth` with each library effect (1 g up, 10 g down): no flag. A sensor gain (1.25) is not a
+    unit; a flexible fixture raises the ratio below resonance (here 1.21 where a rigid one gives 1.11)."""
+    from jointcal.synth import generate
+
+    spec = {"seed": 3, "file_format": "mat", "sweep": {"rate_hz_per_s": 1000.0},
+            "series": [{"level_g": 1.0, "directions": ["up"]}, {"level_g": 10.0, "directions": ["down"]}],
+            "assemblies": {"first": {"Fs": 313.0, "KT": 1.02e6, "chi": -0.65, "beta": 0.004, "k": 6.12e5,
+                                     "zeta_v": 0.0015}},
+            "effect": {"name": effect, "params": params}}
+    generate(spec, tmp_path / "c", tmp_path / "truth.json")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert (ingest_campaign(tmp_path / "c")["flags"] == "").all()
+    if params:
+        row = read_manifest(tmp_path / "c" / "manifest.csv").iloc[0]
+        df = read_run(tmp_path / "c" / row["file"], row)
+        low = low_frequency_ratio(df["base_accel_g"].to_numpy(), df["response_accel_g"].to_numpy(), 12800.0,
+                                  row["f_start_hz"], row["f_stop_hz"], row["sweep_rate_hz_per_s"])
+        assert low[1] > 1.18  # by physics, not by units
+
+
+def test_units_check_says_nothing_when_another_mode_sits_at_the_band_bottom():
+    """A second mode at 745 Hz (participation 0.5) lifts the response/base ratio at the 700 Hz band bottom to
+    7.5 times a single mode's rise, inside the m/s^2 band: the ratio does not follow one mode over the first
+    quarter of the way to the 2.2 kHz peak, so nothing is named (exact linear responses, scipy.signal.lsim)."""
+    from scipy import signal
+
+    fs, f0, f1, rate = 12800.0, 700.0, 2600.0, 1000.0
+    t = np.arange(int(((f1 - f0) / rate + 0.05) * fs)) / fs
+    tt = np.minimum(t, (f1 - f0) / rate)
+    base = np.sin(2 * np.pi * (f0 * tt + 0.5 * rate * tt**2)) * (t < (f1 - f0) / rate)
+
+    def relative_accel(fn: float, zeta: float) -> np.ndarray:  # z'' of z'' + 2 zeta w z' + w^2 z = -a_base
+        w = 2 * np.pi * fn
+        sdof = signal.StateSpace([[0.0, 1.0], [-w * w, -2 * zeta * w]], [[0.0], [-1.0]], [[-w * w, -2 * zeta * w]],
+                                 [[0.0]])
+        return signal.lsim(sdof, base, t)[1] - base
+
+    resp = base + relative_accel(2200.0, 0.02) + 0.5 * relative_accel(745.0, 0.02)
+    assert low_frequency_ratio(base, resp, fs, f0, f1, rate) is None
+    row = {"run_id": "r", "assembly": "a", "sequence": 1, "level_g": 1.0, "direction": "up", "f_start_hz": f0,
+           "f_stop_hz": f1, "sweep_rate_hz_per_s": rate, "sample_rate_hz": fs, "file": "r.csv"}
+    df = pd.DataFrame({"time_s": t, "base_accel_g": base, "response_accel_g": resp})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert validate_run(df, row, "r.csv")["flags"] == []
+
+
+def test_a_voltage_driven_response_in_other_units_cannot_be_seen_and_the_contract_says_so(voltage):
+    """Nothing in a voltage-driven record fixes the response's scale: x9.81 passes unflagged, and the
+    contract docs say so with the user's own check."""
+    edit_run(voltage, read_manifest(voltage / "manifest.csv")["file"].iloc[0], _scale("response_accel_g", G_SI))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert (ingest_campaign(voltage)["flags"] == "").all()
+    for doc in (REPO / "README.md", REPO / "raw_data" / "README.md"):
+        text = " ".join(doc.read_text().split())
+        assert "cannot be checked" in text and "response units on a voltage- or force-driven run" in text, doc
+
+
+# ------------------------------------------------------------------------ the manifest
+
+
+def test_one_record_under_two_spellings_is_one_record(example, capsys):
+    edit_manifest(example, lambda m: pd.concat([m, m.iloc[[0]].assign(run_id="again", sequence="13",
+                                                                        file=f"./{FILE}")]))
+    _stopped(example, capsys, "manifest.csv: lines 2, 4", f"name one file, as '{FILE}' and './{FILE}'",
+             "give each run its own record file")
+
+
+def test_spreadsheet_trailing_empty_rows_are_left_out_with_a_note(example, capsys):
+    with open(example / "manifest.csv", "a") as fh:
+        fh.write(",,,,,,,,,\n" * 3)
+    code, err, runs = _ingest(example, capsys)
+    assert code == 0 and list(runs.index) == [RUN, OTHER] and (runs["flags"] == "").all(), err
+    _one_sentence(err.splitlines()[0].removeprefix("jointcal: warning: "), "manifest.csv: lines 4-6 are empty",
+                  "delete them from the manifest")
+
+
+@pytest.mark.parametrize("where", ["manifest", "run"])
+def test_a_trailing_comma_on_every_line_is_named(example, capsys, where):
+    path = example / ("manifest.csv" if where == "manifest" else FILE)
+    if where == "manifest":
+        lines = path.read_text().splitlines()
+        path.write_text("".join(f"{line},\n" for line in lines))
+    else:
+        read_run(path).to_csv(path, index=False, float_format="%.9g")
+        import gzip
+
+        text = gzip.decompress(path.read_bytes()).decode().splitlines()
+        path.write_bytes(gzip.compress("".join(f"{line},\n" for line in text).encode()))
+    _stopped(example, capsys, path.name, "every line ends with a comma, which adds an empty last column",
+             "remove the trailing commas")
+
+
+def test_trailing_commas_on_the_data_lines_only_are_named(example, capsys):
+    """pandas would silently shift the columns (the first becomes the index)."""
+    path = example / "manifest.csv"
+    lines = path.read_text().splitlines()
+    path.write_text(lines[0] + "\n" + "".join(f"{line},\n" for line in lines[1:]))
+    _stopped(example, capsys, "manifest.csv", "every data line ends with a comma", "remove the trailing commas")
+
+
+@pytest.mark.parametrize("content, words", [
+    ("gzip", ["first_01_1g_up.csv: it is gzip-compressed but named .csv",
+              "rename it first_01_1g_up.csv.gz (also in the manifest's file column) or decompress it"]),
+    ("xlsx", ["first_01_1g_up.csv: it is a zip archive (an Excel workbook?) but named .csv",
+              "save it from the spreadsheet as 'CSV UTF-8 (comma delimited)'"]),
+])
+def test_a_record_that_is_not_csv_text_is_named(example, capsys, content, words):
+    plain = example / "runs" / f"{RUN}.csv"
+    if content == "gzip":
+        (example / FILE).rename(plain)
+    else:
+        with zipfile.ZipFile(plain, "w") as z:
+            z.writestr("xl/workbook.xml", "<workbook/>")
+    edit_manifest(example, lambda m: m.assign(file=m["file"].where(m["run_id"] != RUN, f"runs/{RUN}.csv")))
+    _stopped(example, capsys, *words)
+
+
+@pytest.mark.parametrize("case", ["windows path", "missing file"])
+def test_a_windows_path_or_a_missing_file_is_named_when_the_manifest_is_read(example, capsys, case):
+    if case == "windows path":
+        edit_manifest(example, lambda m: m.assign(file=m["file"].where(m["run_id"] != RUN, f"runs\\{RUN}.csv.gz")))
+        words = [f"manifest.csv: line 2 (run_id '{RUN}'): file 'runs\\{RUN}.csv.gz'", "Windows backslash ('\\')",
+                 f"write it with '/' ({FILE})"]
+    else:
+        (example / FILE).unlink()
+        words = [FILE, f"the file of run '{RUN}' listed in manifest.csv (line 2) does not exist",
+                 "add the file or correct its name"]
+    _stopped(example, capsys, *words)
+
+
+# ------------------------------------------------------------------------ voltage-driven runs
+
+
+def test_a_level_v_typed_ten_times_too_large_is_flagged(voltage, capsys):
+    rid = "beam_01_0.3V_up"
+    edit_manifest(voltage, lambda m: m.assign(level_V=m["level_V"].where(m["run_id"] != rid, "3.0")))
+    _flagged(voltage, capsys, rid, "level:drive_V", "runs/beam_01_0.3V_up.csv.gz: drive amplitude is 0.3 V where "
+             "the manifest says level_V = 3 V", f"correct level_V of run '{rid}' in manifest.csv")
+
+
+def test_a_drive_in_millivolts_is_named(voltage, capsys):
+    rid, file = "beam_02_0.3V_down", "runs/beam_02_0.3V_down.csv.gz"
+    edit_run(voltage, file, _scale("drive_V", 1000.0))
+    _flagged(voltage, capsys, rid, "level:drive_V", file, "is drive_V in mV?", "export drive_V in V (divide by 1000)")
+
+
+def test_swapped_drive_and_response_on_a_voltage_run_are_named(voltage, capsys):
+    rid, file = "beam_01_0.3V_up", "runs/beam_01_0.3V_up.csv.gz"
+    edit_run(voltage, file, lambda d: d.rename(columns={"drive_V": "response_accel_g", "response_accel_g": "drive_V"}))
+    runs = _flagged(voltage, capsys, rid, "swapped:drive_V", file, "the drive voltage is flat",
+                    "the two columns look swapped", "export each channel under its own name")
+    assert runs.loc[rid, "f_first_hz"] == pytest.approx(60.0, abs=2.0)  # the band is read from the true drive
+
+
+def test_a_mat_file_with_other_variable_names_lists_them(voltage, capsys):
+    rid = "beam_01_0.3V_up"
+    df = read_run(voltage / "runs" / f"{rid}.csv.gz")
+    scipy.io.savemat(voltage / "runs" / f"{rid}.mat", {"t": df["time_s"].to_numpy(), "volts": df["drive_V"].to_numpy(),
+                                                       "acc": df["response_accel_g"].to_numpy()})
+    edit_manifest(voltage, lambda m: m.assign(file=m["file"].where(m["run_id"] != rid, f"runs/{rid}.mat")))
+    msg = _stopped(voltage, capsys, f"{rid}.mat: variable 'time_s' is missing", "(the file's variables: t, volts, acc)",
+                   "save the MAT variables time_s,drive_V,response_accel_g")
+    assert "base_accel_g" not in msg and "column" not in msg
+
+
+def test_a_mat_file_without_the_drive_names_the_voltage_channel(voltage, capsys):
+    rid = "beam_01_0.3V_up"
+    df = read_run(voltage / "runs" / f"{rid}.csv.gz")
+    scipy.io.savemat(voltage / "runs" / f"{rid}.mat", {"time_s": df["time_s"].to_numpy(),
+                                                       "response_accel_g": df["response_accel_g"].to_numpy()})
+    edit_manifest(voltage, lambda m: m.assign(file=m["file"].where(m["run_id"] != rid, f"runs/{rid}.mat")))
+    _stopped(voltage, capsys, "variable 'drive_V' (the manifest's level_V makes the run voltage-driven) is missing",
+             "(the file's variables: time_s, response_accel_g)")
+
+
+# ------------------------------------------------------------------------ time
+
+
+def test_jittered_time_is_named(example, capsys):
+    rng = np.random.default_rng(5)
+
+    def jitter(d: pd.DataFrame) -> None:
+        d["time_s"] = d["time_s"] + rng.uniform(-0.1, 0.1, len(d)) / 12800.0  # +/- 10 % of a step per sample
+    edit_run(example, FILE, jitter)
+    _stopped(example, capsys, FILE, "time_s is not evenly spaced", "of a step off a uniform grid",
+             "export the DAQ's own sample times (t0 + i / sample rate)")
+
+
+@pytest.mark.parametrize("fmt, bound", [("%.7g", 5e-6), ("%.5f", 5e-6), ("float32", 2.0**-24 * 60)])
+def test_rounded_times_are_not_jitter(fmt, bound):
+    """A 60 s record at 12.8 kHz written with 7 significant digits or 5 decimals (rounded by up to 6 % of a
+    step), or in float32 (3 %): the way the times were written, not jitter."""
+    t = np.arange(int(60 * 12800)) / 12800.0
+    t = t.astype(np.float32).astype(float) if fmt == "float32" else np.array([float(fmt % v) for v in t])
+    assert time_resolution(t).max() == pytest.approx(bound, rel=0.01)
+    assert _check_time(t, 12800.0, "r.csv", "'r'") == pytest.approx(12800.0, rel=1e-6)
+
+
+def _with_head(seconds: float):
+    def edit(d: pd.DataFrame) -> pd.DataFrame:
+        n = int(round(seconds * 12800))
+        rng = np.random.default_rng(2)
+        head = pd.DataFrame({c: 1e-4 * rng.standard_normal(n) for c in ("base_accel_g", "response_accel_g")})
+        out = pd.concat([head, d[["base_accel_g", "response_accel_g"]]], ignore_index=True)
+        return out.assign(time_s=np.arange(len(out)) / 12800.0)[["time_s", "base_accel_g", "response_accel_g"]]
+    return edit
+
+
+def test_a_silent_pre_trigger_head_is_named_and_sweep_start_s_reads_the_run(example, capsys):
+    edit_run(example, FILE, _with_head(0.25))
+    _stopped(example, capsys, FILE, "the drive starts 0.25 s after the record's first sample (a silent pre-trigger "
+             "head of 3200 samples)", "trim the head", f"sweep_start_s column (0.25 for run '{RUN}')")
+    edit_manifest(example, lambda m: m.assign(sweep_start_s=np.where(m["run_id"] == RUN, "0.25", "")))
+    code, err, runs = _ingest(example, capsys)
+    assert code == 0 and (runs["flags"] == "").all(), err
+    assert runs.loc[RUN, "f_first_hz"] == pytest.approx(700.0, abs=5.0)
+    assert runs.loc[RUN, "sweep_start_s"] == 0.25 and runs.loc[OTHER, "sweep_start_s"] == 0.0
+    row = read_manifest(example / "manifest.csv").iloc[0]
+    assert len(read_run(example / FILE, row)) == len(read_run(REPO / "raw_data" / FILE))
+
+
+# ------------------------------------------------------------------------ the workflow
+
+
+def _snakemake(work: Path, *args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", *args], cwd=work, capture_output=True,
+                          text=True, timeout=900)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", ["windows path", "missing file"])
+def test_workflow_names_a_windows_path_or_a_missing_file_before_looking_for_inputs(tmp_path, example, case):
+    if case == "windows path":
+        edit_manifest(example, lambda m: m.assign(file=m["file"].str.replace("/", "\\")))
+        words = f"file 'runs\\{RUN}.csv.gz' is written with a Windows backslash"
+    else:
+        (example / FILE).unlink()
+        words = f"{FILE}: the file of run '{RUN}' listed in manifest.csv (line 2) does not exist"
+    out = tmp_path / "results"
+    res = _snakemake(workflow_copy(tmp_path), "ingest", "--config", f"raw_data={example}", f"results={out}")
+    assert res.returncode != 0
+    assert "MissingInputException" not in res.stderr and "Traceback" not in res.stderr, res.stderr
+    assert f"jointcal: {example / 'manifest.csv'}" in res.stderr or f"jointcal: {example / FILE}" in res.stderr
+    assert words in res.stderr
+    log = (out / "logs" / "ingest.log").read_text().splitlines()
+    assert len(log) == 1 and words in log[0]
+    assert not (out / "ingest").exists()
+
+
+@pytest.mark.slow
+def test_workflow_keeps_a_response_units_mistake_out_of_the_calibration(tmp_path, example):
+    """The flagged run reaches modal_properties.csv as unusable; the calibration's selection leaves it out."""
+    from jointcal.calibrate.data import select_modal
+
+    edit_run(example, FILE, _scale("response_accel_g", G_SI))
+    out = tmp_path / "results"
+    res = _snakemake(workflow_copy(tmp_path), str(out / "modal" / "modal_properties.csv"),
+                     "--config", f"raw_data={example}", f"results={out}")
+    assert res.returncode == 0, res.stderr[-3000:]
+    assert f"{FILE}: below resonance" in (out / "logs" / "ingest.log").read_text()
+    modal = pd.read_csv(out / "modal" / "modal_properties.csv", keep_default_na=False).set_index("run_id")
+    assert modal.loc[RUN, "flags"].split(";")[0] == "units:response_accel_g"
+    assert "unusable" in modal.loc[RUN, "flags"].split(";") and "unusable" not in modal.loc[OTHER, "flags"]
+    assert select_modal(modal.reset_index(), "first").run_id == (OTHER,)
