@@ -66,7 +66,7 @@ def test_space_grows_by_named_parameters_with_their_scaling():
     ({"Fs": [0.0, 10.0]}, "Fs.*lower bound must be > 0"),
     ({"chi": [-1.2, 0.0]}, "chi must lie in"),
     ({"KT": [1e6, 1e5]}, "lower < upper"),
-    ({"kappa": [1.0, 2.0]}, "unknown: kappa"),
+    ({"kappa": [1.0, 2.0]}, r"unknown parameter\(s\) kappa; they are Fs, KT"),
 ])
 def test_space_rejects_bad_bounds(bounds, match):
     with pytest.raises(ValueError, match=match):
@@ -129,7 +129,7 @@ def _break(tmp_path, edit):
 @pytest.mark.parametrize("edit, message", [
     (lambda d: d.pop("q_in"), "column(s) q_in missing"),
     (lambda d: d.__setitem__("flags", "unusable"), "all 12 runs of assembly 'first' are flagged unusable"),
-    (lambda d: d.loc.__setitem__((3, "f_res_hz"), np.nan), "run 'first_04_1g_down' has f_res_hz = nan"),
+    (lambda d: d.__setitem__("zeta_res", np.nan), "set calibrate.damping to zeta_phase_resonance"),
     (lambda d: d.__setitem__("assembly", "other"), "no runs of assembly 'first'"),
 ])
 def test_bad_modal_table_is_one_sentence_naming_the_file(tmp_path, edit, message):
@@ -138,6 +138,25 @@ def test_bad_modal_table_is_one_sentence_naming_the_file(tmp_path, edit, message
         read_modal(modal_csv, "first")
     text = str(err.value)
     assert text.startswith(f"{modal_csv}: ") and message in text and text.endswith(".") and "\n" not in text
+
+
+def test_a_run_without_a_read_out_is_left_out_with_a_note(tmp_path):
+    modal_csv = _break(tmp_path, lambda d: d.loc.__setitem__((3, "f_res_hz"), np.nan))
+    d = read_modal(modal_csv, "first")
+    assert "first_04_1g_down" not in d.run_id and len(d.run_id) == 11
+    assert any("'first_04_1g_down' has no positive q_in, f_res_hz and zeta_res" in n and n.endswith("left out")
+               for n in d.notes)
+
+
+def test_a_voltage_campaign_asked_for_phase_resonance_damping_is_told_which_column_it_has():
+    """A voltage-driven run has no phase-resonance damping (the voltage is not a force): the sentence says
+    so and names the column to use instead of stopping on the first NaN."""
+    modal, _ = modal_tables({"first": TABLE_3_2["first"]}, seed=1)
+    modal = modal.rename(columns={"level_g": "level_V"}).assign(zeta_phase_resonance=np.nan)
+    with pytest.raises(CalibrationInputError) as err:
+        select_modal(modal, "first", damping="zeta_phase_resonance")
+    text = str(err.value)
+    assert "a voltage is not a force" in text and "set calibrate.damping to zeta_res" in text and "\n" not in text
 
 
 def test_missing_table_names_the_file(tmp_path):
@@ -149,7 +168,7 @@ def test_missing_or_zero_pooled_scatter_falls_back_to_the_floor():
     modal, scatter = modal_tables({"first": TABLE_3_2["first"]}, seed=1)
     pooled_f = (scatter["source"] == "pooled") & (scatter["quantity"] == "f_res_hz")
     scatter.loc[pooled_f, "rel_std"] = 0.0
-    scatter = scatter[~((scatter["source"] == "pooled") & (scatter["quantity"] == "zeta_phase_resonance"))]
+    scatter = scatter[~((scatter["source"] == "pooled") & (scatter["quantity"] == "zeta_res"))]
     d = select_modal(modal, "first", scatter=scatter, floors={"frequency": 3e-4, "damping": 0.02})
     assert d.rel_noise == (3e-4, 0.02)
     assert sum("using the floor" in n for n in d.notes) == 2
@@ -159,7 +178,8 @@ def test_missing_or_zero_pooled_scatter_falls_back_to_the_floor():
 
 def test_config_snippet_equals_the_python_defaults():
     keys = yaml.safe_load((REPO / "workflow" / "config" / "config.yaml").read_text())
-    assert CalibrateSettings.from_config(keys["calibrate"]) == CalibrateSettings()
+    # the one difference: the workflow takes the model kind from the campaign (auto), the API defaults to the paper's
+    assert CalibrateSettings.from_config(keys["calibrate"]) == CalibrateSettings(model_kind="auto")
     with pytest.raises(ValueError, match="unknown key"):
         CalibrateSettings.from_config({"populaton": 10})
 

@@ -90,6 +90,10 @@ def _write_csv(path, cols: dict) -> None:
     pd.DataFrame(cols).to_csv(path, index=False, float_format="%.12g")
 
 
+SWEEP_FIT_KEYS = ("f_res_hz", "zeta_res", "q_in", "eta", "f_sweep_hz", "zeta_sweep", "modal_constant_re",
+                  "modal_constant_im", "modal_slope_re", "modal_slope_im", "q_peak_in")  # q_peak_in: at f_res_hz
+
+
 def test_response_in_m_s2_gives_the_same_modal_table(tmp_path):
     t, ref, resp, rate = _linear_record(2.0, base=False)
     _write_csv(tmp_path / "g.csv", {"time_s": t, "force_lbf": ref, "response_accel_g": resp})
@@ -102,8 +106,10 @@ def test_response_in_m_s2_gives_the_same_modal_table(tmp_path):
     for key, v in pa.items():
         if isinstance(v, float) and np.isfinite(v):
             # the fits' relative misfits of a noise-free record are float round-off themselves (< 1e-5):
-            # equal to 1e-9 absolute, every physical quantity to 1e-8 relative
-            assert pb[key] == pytest.approx(v, rel=1e-8, abs=1e-9 if key.endswith("_residual") else 0), key
+            # equal to 1e-7 absolute; the iterative fits (least squares stops at relative cost changes of
+            # 1e-8) to 1e-6 relative from a rounding-level change of the input, everything else to 1e-8
+            tol = 1e-6 if key in SWEEP_FIT_KEYS else 1e-8
+            assert pb[key] == pytest.approx(v, rel=tol, abs=1e-7 if key.endswith("_residual") else 0), key
         else:
             assert pb[key] == v or (v != v and pb[key] != pb[key]), key
     assert pa["f_res_method"] == "sweep_fit" and pa["zeta_sweep"] == pytest.approx(ZETA, rel=0.01)

@@ -64,6 +64,10 @@ FLAG_WORDS = {
     "frf_misfit": "the FRF's peak is not one linear mode (fit residual above frf_misfit: a nonlinear "
                   "structure's bent peak, a transient, overlapping modes or noise); zeta_frf and f_frf_hz are "
                   "doubtful, a quadrature read-out less so",
+    "sweep_fit_failed": "the whole-transient fit of one mode did not fit (sweep_note says why); the FRF read-out "
+                        "is reported at the band-limited envelope peak, usable only for a quasi-steady sweep",
+    "units": "the response/base ratio below resonance says the response is in other units than its column "
+             "name (ingest's check); the run is left out",
     "unusable": "no resonance could be estimated from this run",
 }
 
@@ -190,8 +194,7 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
                zeta_frf=fit.zeta if fit else np.nan, f_backbone_hz=float(f_bb), zeta_backbone=float(z_bb),
                f_sweep_hz=sweep.f_hz if sweep else np.nan, zeta_sweep=sweep.zeta if sweep else np.nan,
                sweep_residual=sweep.residual if sweep else np.nan,
-               modal_constant_re=sweep.modal_constant.real if sweep else np.nan,
-               modal_constant_im=sweep.modal_constant.imag if sweep else np.nan,
+               **_modal_constant(sweep),
                frf_residual=fit.residual if fit else np.nan, frf_truncated=fit.truncated if fit else np.nan,
                flags=";".join(dict.fromkeys(flags)))
     return (out, tab) if with_frf else out
@@ -209,6 +212,17 @@ READOUT_RULE = (
     "quadrature_slope beyond eta_max) at the envelopes' amplitude there, or the FRF fit's quadrature beyond "
     "eta_frf (frf_fit), with the phase-resonance damping; the envelope peak (peak) where the phase never "
     "reaches quadrature.")
+
+
+def _modal_constant(sweep) -> dict:
+    """The swept-mode fit's modal constant at its resonance, A(w_r), and its slope dA/dw (per rad/s): the
+    columns modal_constant_re/_im, modal_slope_re/_im ((in/s^2) per reference unit; NaN without a fit)."""
+    if sweep is None:
+        return dict(modal_constant_re=np.nan, modal_constant_im=np.nan, modal_slope_re=np.nan, modal_slope_im=np.nan)
+    wr = 2 * np.pi * sweep.f_hz
+    a = sweep.modal_constant + sweep.modal_slope * (wr / sweep.w0 - 1.0)
+    da = sweep.modal_slope / sweep.w0
+    return dict(modal_constant_re=a.real, modal_constant_im=a.imag, modal_slope_re=da.real, modal_slope_im=da.imag)
 
 
 def readout_rule() -> str:
@@ -504,7 +518,9 @@ def scatter(table: pd.DataFrame) -> pd.DataFrame:
     ok = ~table["flags"].fillna("").str.contains("unusable")
     rows = []
     for (asm), grp in table[ok].groupby("assembly", sort=False):
-        for qty in ("f_res_hz", "zeta_phase_resonance", "zeta_half_power"):
+        for qty in ("f_res_hz", "zeta_res", "zeta_phase_resonance", "zeta_half_power"):
+            if qty not in grp.columns:
+                continue
             ss, dof = 0.0, 0
             for lev, g in grp.groupby(level, sort=True):
                 v = g[qty].dropna().to_numpy(float)

@@ -50,6 +50,9 @@ def _manifest_rows():
 RUN_FILES = {r["run_id"]: str(RAW_DATA / r.get("file", "")) for r in _manifest_rows() if r.get("run_id")}
 RUN_IDS = list(RUN_FILES)
 ASSEMBLIES = list(dict.fromkeys(r["assembly"] for r in _manifest_rows() if r.get("assembly")))
+# the campaign's reference kind from the manifest's level column (base unless level_lbf / level_V)
+EXCITATION = next((k for k, col in (("force", "level_lbf"), ("voltage", "level_V"))
+                   if _manifest_rows() and col in _manifest_rows()[0]), "base")
 _CHECKED = []
 
 

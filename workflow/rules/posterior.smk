@@ -88,6 +88,7 @@ rule report_summary:
         modal=RESULTS / "modal" / "modal_properties.csv",
         table=POSTERIOR / "table_3_2.csv",
         history=expand(RESULTS / "calibration" / "{assembly}" / "ga_history.csv", assembly=ASSEMBLIES),
+        best=expand(RESULTS / "calibration" / "{assembly}" / "ga_best.json", assembly=ASSEMBLIES),
         chain=expand(POSTERIOR / "{assembly}" / "chain.npz", assembly=ASSEMBLIES),
         constraints=expand(POSTERIOR / "{assembly}" / "constraints.txt", assembly=ASSEMBLIES),
     output:

@@ -16,10 +16,9 @@ from jointcal.report.summary import bound_hits, fmt, ga_best_point, rst_escape
 
 def main(smk) -> None:
     name = smk.wildcards.assembly
-    cal = CalibrateSettings.from_config(smk.params.calibrate)
-    bounds = {k: list(v) for k, v in cal.bounds.items()}
     history = pd.read_csv(smk.input.history)
     best = json.loads(Path(smk.input.best).read_text())
+    bounds = CalibrateSettings.from_config(smk.params.calibrate).resolved(best).full_bounds
     ga = ga_best_point(history)
     polished = {p: best[p] for p in PARAMS} | {"objective": best["objective"]}
     write_bytes_atomic(exploration_figure(history, title=name, ga_best=ga, polished=polished, bounds=bounds),

@@ -41,7 +41,7 @@ def main(smk) -> None:
         records = [read_run(listed_record(str(r["file"]), list(smk.input.records)), r) for r in rows]
         best = json.loads(Path(smk.input.best).read_text())
         summary = json.loads(Path(smk.input.validation).read_text())
-        space = CalibrateSettings.from_config(smk.params.calibrate).space
+        space = CalibrateSettings.from_config(smk.params.calibrate).resolved(best).space
         starts = valley_starts(pd.read_csv(smk.input.history), best)
         n = max(1, int(smk.threads))
         with ProcessPoolExecutor(max_workers=n) as ex:

@@ -55,7 +55,8 @@ def main(smk) -> None:
             notes.append(f"{rid}: unusable: ingest flagged {', '.join(wrong)} (see the ingest log); "
                          "left out of the calibration")
         for flag in [f for f in out["flags"].split(";") if f.split(":")[0] in FLAG_WORDS or ":" in f]:
-            notes.append(f"{rid}: {flag.split(':')[0]}: {FLAG_WORDS.get(flag.split(':')[0], flag)}.")
+            why = f" ({out['sweep_note']})" if flag == "sweep_fit_failed" and out.get("sweep_note") else ""
+            notes.append(f"{rid}: {flag.split(':')[0]}: {FLAG_WORDS.get(flag.split(':')[0], flag)}{why}.")
         rows.append(out)
     table = pd.DataFrame(rows)
     write_csv_atomic(table, smk.output.table)

@@ -19,7 +19,8 @@ from jointcal.report.summary import chain_status, ga_best_point, rst_escape
 
 
 def main(smk) -> None:
-    cal = CalibrateSettings.from_config(smk.params.calibrate)
+    best = json.loads(Path(smk.input.best).read_text())
+    cal = CalibrateSettings.from_config(smk.params.calibrate).resolved(best)
     post = PosteriorSettings.from_config(smk.params.posterior)
     with np.load(smk.input.chain) as z:
         arrays = {k: z[k] for k in z.files}
@@ -31,11 +32,11 @@ def main(smk) -> None:
     def coords(point: dict) -> list:
         return [(np.log10(point[n]) if lg else point[n]) if n in point else np.nan for n, lg in zip(names, log)]
 
-    best = json.loads(Path(smk.input.best).read_text())
     points = {"GA best": coords(ga_best_point(pd.read_csv(smk.input.history))),
               "polished optimum": coords({p: best[p] for p in PARAMS})}
-    lo = [cal.bounds[n][0] if n in cal.bounds else np.nan for n in names]
-    hi = [cal.bounds[n][1] if n in cal.bounds else np.nan for n in names]
+    full = cal.full_bounds
+    lo = [full[n][0] if n in full else np.nan for n in names]
+    hi = [full[n][1] if n in full else np.nan for n in names]
     bounds = (coords(dict(zip(names, lo))), coords(dict(zip(names, hi))))
     ok, line = chain_status(arrays, tau_factor=post.tau_factor)
     modes = arrays.get("sample_mode")

@@ -24,7 +24,7 @@ def main(smk) -> None:
         measured[a] = pd.DataFrame({"q_in": d.q, "f_hz": d.f, "zeta": d.zeta})
         by_level = pd.notna(d.level).all()
         q = pd.Series(d.q).groupby(d.level if by_level else list(d.run_id), sort=by_level).mean()  # one q per level
-        t = qsma_vs_harmonic_balance(best[a], q.to_numpy(), m=cal.m, viscous=cal.viscous)
+        t = qsma_vs_harmonic_balance(best[a], q.to_numpy(), m=cal.resolved(best[a]).m, viscous=cal.viscous)
         t.insert(0, "assembly", a)
         t.insert(1, "level" if by_level else "run_id", q.index.to_numpy())
         comparison.append(t)

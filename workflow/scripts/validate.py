@@ -16,6 +16,7 @@ import pandas as pd
 
 from jointcal.io import listed_record, read_run, write_csv_atomic, write_json_atomic
 from jointcal.validate import ValidateSettings, model_from_best, models_from_samples, validate_runs
+from jointcal.validate.runs import drive_gain
 
 
 def main(smk) -> None:
@@ -28,7 +29,11 @@ def main(smk) -> None:
         runs = pd.read_csv(smk.input.runs, dtype={"flags": str})
         rows = runs[runs["assembly"] == asm].to_dict("records")
         records = [read_run(listed_record(str(r["file"]), list(smk.input.records)), r) for r in rows]
-        modal = pd.read_csv(smk.input.modal).set_index("run_id")
+        modal_table = pd.read_csv(smk.input.modal)
+        modal = modal_table.set_index("run_id")
+        gain = drive_gain(modal_table[modal_table["assembly"] == asm]) if "base_accel_g" not in records[0] else None
+        if gain is not None:  # a force or voltage drives the mode through the campaign's modal constant
+            rows = [{**r, "drive_gain": gain} for r in rows]
         f_res = {r["run_id"]: float(modal.loc[r["run_id"], "f_res_hz"]) for r in rows if r["run_id"] in modal.index}
         f_ref = float(np.nanmedian(list(f_res.values()))) if f_res else None
         with np.load(smk.input.chain) as z:
@@ -53,17 +58,29 @@ def main(smk) -> None:
         if len(fr):
             write_csv_atomic(fr, out / f"{rid}.csv")
     out.mkdir(parents=True, exist_ok=True)
+    for rid, tr in v.traces.items():  # force- and voltage-driven runs: the response envelope in time
+        write_csv_atomic(tr, out / "traces" / f"{rid}.csv")
     write_csv_atomic(v.metrics, smk.output.metrics)
     m = v.metrics
+    words = v.words
+    if gain is not None:
+        words += (f" How the model is driven: the calibrated mode is driven by its modal force per unit modal mass "
+                  f"A(w) r(t), the recorded {'force' if 'force_lbf' in records[0] else 'amplifier voltage'} through "
+                  f"the campaign's modal constant A = {gain[0].real:.4g}{gain[0].imag:+.4g}i "
+                  f"(in/s^2 per reference unit at {gain[2] / (2 * 3.141592653589793):.4g} Hz, sloped "
+                  f"{abs(gain[1]) * gain[2] / abs(gain[0]):.3g} of itself per unit w/w_c), the median over the "
+                  "swept-mode fits" + (": the shaker's electrical and residual dynamics in one complex gain; its "
+                                       "back-EMF damping is in the calibrated mode's." if "drive_V" in records[0]
+                                       else "." ))
     summary = {**{k: v.error[k] for k in ("E", "E_mag", "E_phase", "n_runs", "per_level", "scale")},
-               "words": v.words, "assembly": asm, "n_draws": len(draws),
+               "words": words, "assembly": asm, "n_draws": len(draws),
                "median_peak_ratio": float(np.nanmedian(m["peak_ratio"])) if "peak_ratio" in m else None,
                "median_f_res_rel_err": float(np.nanmedian(m["f_res_rel_err"])) if "f_res_rel_err" in m else None,
                "median_zeta_rel_err": float(np.nanmedian(m["zeta_rel_err"])) if "zeta_rel_err" in m else None,
                "model": {k: best[k] for k in ("Fs", "KT", "chi", "beta", "k", "zeta_v", "m", "viscous")},
                "settings": dict(smk.params.validate), "wall_s": time.perf_counter() - t0}
     write_json_atomic(summary, smk.output.summary)
-    lines = [f"jointcal: {asm}: {v.words}"]
+    lines = [f"jointcal: {asm}: {words}"]
     lines += [f"jointcal: warning: {r.run_id}: not validated: {r.note}" for r in m.itertuples() if r.n_frames == 0]
     for line in lines[1:]:
         print(line, file=sys.stderr)

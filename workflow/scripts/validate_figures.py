@@ -16,7 +16,9 @@ def main(smk) -> None:
     metrics = {a: pd.read_csv(p) for a, p in zip(names, smk.input.metrics)}
     errors = {a: json.loads(Path(p).read_text())["E"] for a, p in zip(names, smk.input.summary)}
     frames = {a: {p.stem: pd.read_csv(p) for p in sorted(Path(d).glob("*.csv"))} for a, d in zip(names, smk.input.envelopes)}
-    write_bytes_atomic(validation_figure(frames, metrics, errors), smk.output.figure)
+    traces = {a: {p.stem: pd.read_csv(p) for p in sorted((Path(d) / "traces").glob("*.csv"))}
+              for a, d in zip(names, smk.input.envelopes)}
+    write_bytes_atomic(validation_figure(frames, metrics, errors, traces=traces), smk.output.figure)
     Path(smk.log[0]).write_text("".join(f"jointcal: {a}: E = {e:.2f}\n" for a, e in errors.items()))
 
 

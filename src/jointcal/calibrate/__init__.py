@@ -1,6 +1,7 @@
 """Calibration stage: a GA (DEAP) on the paper's eq. 3.9, per assembly.
 
 Modules in the order data flows: `data` (the modal stage's tables -> `ModalData`),
+`kind` (what the model is: the Ministack, or one mode of any structure, and its bounds),
 `space` (bounds and the GA's unit cube), `objective` (eq. 3.9, vectorised over a
 population), `ga` (DEAP loop with stall stop and checkpoints), `fit` (GA + polish ->
 tables), `settings` (the ``calibrate:`` config section) and `stage` (files).
@@ -8,10 +9,11 @@ tables), `settings` (the ``calibrate:`` config section) and `stage` (files).
 from .data import DAMPING, CalibrationInputError, ModalData, read_modal, read_table, select_modal
 from .fit import Calibration, calibrate, model_curves, polish, polish_starts
 from .ga import GAOptions, GAResult, run_ga
+from .kind import KINDS, data_bounds, excitation_of_table, kind_of, model_words
 from .objective import MODELS, PENALTY, objective, predict
 from .settings import DEFAULT_BOUNDS, CalibrateSettings
 from .space import LOG_SCALED, PARAMS, UNITS, ParamSpace
-from .stage import OUTPUTS, run_calibration
+from .stage import OUTPUTS, resolve, run_calibration
 
 __all__ = [
     "CalibrationInputError", "ModalData", "DAMPING", "read_modal", "read_table", "select_modal",
@@ -20,5 +22,6 @@ __all__ = [
     "GAOptions", "GAResult", "run_ga",
     "Calibration", "calibrate", "polish", "polish_starts", "model_curves",
     "CalibrateSettings", "DEFAULT_BOUNDS",
-    "OUTPUTS", "run_calibration",
+    "OUTPUTS", "resolve", "run_calibration",
+    "KINDS", "data_bounds", "excitation_of_table", "kind_of", "model_words",
 ]

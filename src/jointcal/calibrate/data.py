@@ -28,8 +28,8 @@ from jointcal._checks import UNUSABLE_FLAGS
 
 __all__ = ["CalibrationInputError", "ModalData", "DAMPING", "select_modal", "read_modal", "read_table"]
 
-Damping = Literal["zeta_phase_resonance", "zeta_half_power"]
-DAMPING: tuple[str, ...] = ("zeta_phase_resonance", "zeta_half_power")
+Damping = Literal["zeta_res", "zeta_phase_resonance", "zeta_half_power"]
+DAMPING: tuple[str, ...] = ("zeta_res", "zeta_phase_resonance", "zeta_half_power")
 FREQUENCY = "f_res_hz"
 _MODAL_COLUMNS = ("run_id", "assembly", "q_in", FREQUENCY, "flags")
 _SCATTER_COLUMNS = ("assembly", "quantity", "source", "rel_std")
@@ -51,9 +51,10 @@ class ModalData:
     ----------
     assembly : str
     run_id : tuple of str, length N
-    level : ndarray, shape (N,) -- drive level (g, or lbf for force-driven runs); NaN
+    level : ndarray, shape (N,) -- drive level (g; lbf or V for force- or voltage-driven runs); NaN
         when the table has no level column.
-    q : ndarray, shape (N,) -- relative displacement amplitude at resonance, in.
+    q : ndarray, shape (N,) -- amplitude the read-out belongs to (q_in), in: the joint's relative
+        displacement at resonance (base-driven), the mode's largest displacement (force, voltage).
     f : ndarray, shape (N,) -- resonance frequency, Hz.
     zeta : ndarray, shape (N,) -- damping ratio (0.02, not 2%) from ``damping``.
     damping : str -- the damping column used.
@@ -98,7 +99,7 @@ def _pooled(scatter: pd.DataFrame, assembly: str, quantity: str, floor: float, w
     return float(value[0])
 
 
-def select_modal(modal: pd.DataFrame, assembly: str, *, damping: Damping = "zeta_phase_resonance",
+def select_modal(modal: pd.DataFrame, assembly: str, *, damping: Damping = "zeta_res",
                  scatter: pd.DataFrame | None = None, floors: Mapping[str, float] | None = None,
                  modal_name: object = "modal_properties.csv", scatter_name: object = "scatter.csv") -> ModalData:
     """Validate the modal tables and return one assembly's usable runs.
@@ -109,8 +110,10 @@ def select_modal(modal: pd.DataFrame, assembly: str, *, damping: Damping = "zeta
         The modal-properties table (see module notes).
     assembly : str
         Assembly to select.
-    damping : {'zeta_phase_resonance', 'zeta_half_power'}
-        Damping estimator (half power reproduces the paper).
+    damping : {'zeta_res', 'zeta_phase_resonance', 'zeta_half_power'}
+        Damping estimator: zeta_res, the damping of each run's own read-out (the phase-resonance
+        energy balance for base-driven runs, the swept-mode fit's for force- and voltage-driven
+        ones); half power reproduces the paper.
     scatter : pandas.DataFrame, optional
         The scatter table; without it ``rel_noise`` is (NaN, NaN).
     floors : mapping, optional
@@ -125,8 +128,8 @@ def select_modal(modal: pd.DataFrame, assembly: str, *, damping: Damping = "zeta
     Raises
     ------
     CalibrationInputError
-        Missing column, unknown assembly, every run flagged unusable, or a missing,
-        non-numeric or non-positive q_in / f_res_hz / damping value in a usable run.
+        Missing column, unknown assembly, every run flagged unusable, or no usable run with
+        positive q_in, f_res_hz and damping (a run lacking one of them is left out, with a note).
     """
     if damping not in DAMPING:
         raise ValueError(f"damping must be one of {', '.join(DAMPING)}, got {damping!r}")
@@ -146,16 +149,25 @@ def select_modal(modal: pd.DataFrame, assembly: str, *, damping: Damping = "zeta
         _fail(modal_name, f"all {len(rows)} runs of assembly {assembly!r} are flagged unusable",
               "fix the flagged runs or the modal settings; nothing is left to calibrate")
     rows = rows[keep]
-    values = {}
+    finite = np.ones(len(rows), bool)
     for col in ("q_in", FREQUENCY, damping):
         v = pd.to_numeric(rows[col], errors="coerce").to_numpy(float)
-        bad = ~(np.isfinite(v) & (v > 0))
-        if bad.any():
-            i = int(np.flatnonzero(bad)[0])
-            _fail(modal_name, f"run {rows['run_id'].tolist()[i]!r} has {col} = {rows[col].tolist()[i]}, "
-                  "not a positive number", "flag the run unusable or rerun the modal stage")
-        values[col] = v
-    level_col = next((c for c in ("level_g", "level_lbf") if c in rows.columns), None)
+        finite &= np.isfinite(v) & (v > 0)
+    if not finite.all():  # a run without this read-out (e.g. no phase-resonance damping): left out, said why
+        for _, r in rows[~finite].iterrows():
+            notes.append(f"{modal_name}: run {r['run_id']!r} has no positive q_in, {FREQUENCY} and {damping} "
+                         f"(method {r.get('f_res_method', '?')}, flags {r.get('flags', '') or 'none'}); left out")
+    if not finite.any():
+        other = [c for c in DAMPING if c != damping and c in rows.columns
+                 and (pd.to_numeric(rows[c], errors="coerce") > 0).any()]
+        why = (" (a voltage is not a force: no phase-resonance damping)" if damping == "zeta_phase_resonance"
+               and "level_V" in rows.columns else "")
+        _fail(modal_name, f"no usable run of assembly {assembly!r} has a positive q_in, {FREQUENCY} and "
+              f"{damping}{why}", f"set calibrate.damping to {other[0]}" if other
+              else "rerun the modal stage, or check the flags and sweep_note of its runs")
+    rows = rows[finite]
+    values = {col: pd.to_numeric(rows[col], errors="coerce").to_numpy(float) for col in ("q_in", FREQUENCY, damping)}
+    level_col = next((c for c in ("level_g", "level_lbf", "level_V") if c in rows.columns), None)
     level = (np.full(len(rows), np.nan) if level_col is None
              else pd.to_numeric(rows[level_col], errors="coerce").to_numpy(float))
     floors = {"frequency": 1e-4, "damping": 0.01, **(floors or {})}
@@ -184,7 +196,7 @@ def read_table(path: str | os.PathLike[str]) -> pd.DataFrame:
 
 
 def read_modal(modal_csv: str | os.PathLike[str], assembly: str, *, scatter_csv: str | os.PathLike[str] | None = None,
-               damping: Damping = "zeta_phase_resonance", floors: Mapping[str, float] | None = None) -> ModalData:
+               damping: Damping = "zeta_res", floors: Mapping[str, float] | None = None) -> ModalData:
     """`select_modal` on the files ``modal_properties.csv`` (and ``scatter.csv``)."""
     scatter = None if scatter_csv is None else read_table(scatter_csv)
     return select_modal(read_table(modal_csv), assembly, damping=damping, scatter=scatter, floors=floors,

@@ -1,7 +1,10 @@
 """The ``calibrate:`` config section as a frozen settings object, with its defaults.
 
-The defaults equal ``workflow/config/config.yaml``. Bounds are wide enough for
-rigs other than the Ministack (the GA searches them log-uniformly):
+The defaults equal ``workflow/config/config.yaml`` (whose ``model_kind`` is ``auto``:
+`jointcal.calibrate.kind`). The Ministack kind's bounds, `DEFAULT_BOUNDS`, are wide enough
+for rigs other than the Ministack (the GA searches them log-uniformly); the modal kind's
+come from the data (`jointcal.calibrate.kind.data_bounds`); ``bounds`` in the config
+override either, parameter by parameter:
 
 ==========  ==================  ====================================================
 parameter   bounds              reasoning
@@ -24,8 +27,9 @@ from typing import Any, Literal
 from ..models import G
 from .data import DAMPING
 from .ga import GAOptions
+from .kind import KINDS
 from .objective import MODELS
-from .space import ParamSpace
+from .space import PARAMS, ParamSpace
 
 __all__ = ["DEFAULT_BOUNDS", "CalibrateSettings"]
 
@@ -41,9 +45,13 @@ class CalibrateSettings:
     """Settings of the calibration stage (see ``workflow/config/config.yaml``).
 
     model : 'harmonic_balance' or 'qsma'; viscous : 'dashpot' or 'constant' (convention of
-    zeta_v, `jointcal.calibrate.objective`); damping : the modal column fitted; eta : the
-    frequency weight of eq. 3.9; slug_weight_lbf : slug weight, lbf (m = weight / g);
-    bounds : {name: [lower, upper]}; ga : GAOptions (seed included); n_polish : number of
+    zeta_v, `jointcal.calibrate.objective`); damping : the modal column fitted (zeta_res:
+    the damping of each run's own read-out); eta : the frequency weight of eq. 3.9;
+    model_kind : 'ministack', 'modal' or 'auto' (`jointcal.calibrate.kind`: 'auto' is
+    resolved against the modal table by `resolve`); slug_weight_lbf : slug weight, lbf
+    (ministack: m = weight / g); modal_mass : the mode's modal mass, lbf s^2/in (modal; None:
+    per unit modal mass, m = 1); bounds : {name: [lower, upper]}, the config's overrides of
+    the kind's defaults (after `resolve`, all six); ga : GAOptions (seed included); n_polish : number of
     distinct good GA individuals refined by bounded least squares (0: none); curve_points,
     curve_widen : the amplitude grid of model_curves.csv (points; factor beyond the
     measured range on each side).
@@ -51,10 +59,12 @@ class CalibrateSettings:
 
     model: Literal["harmonic_balance", "qsma"] = "harmonic_balance"
     viscous: Literal["dashpot", "constant"] = "dashpot"
-    damping: str = "zeta_phase_resonance"
+    damping: str = "zeta_res"
     eta: float = 0.85
+    model_kind: str = "ministack"
     slug_weight_lbf: float = 2.65
-    bounds: Mapping[str, Any] = field(default_factory=lambda: dict(DEFAULT_BOUNDS))
+    modal_mass: float | None = None
+    bounds: Mapping[str, Any] = field(default_factory=dict)
     ga: GAOptions = GAOptions()
     n_polish: int = 8
     curve_points: int = 200
@@ -71,21 +81,56 @@ class CalibrateSettings:
             raise ValueError(f"calibrate.eta must lie in [0, 1], got {self.eta!r}")
         if not self.slug_weight_lbf > 0:
             raise ValueError(f"calibrate.slug_weight_lbf must be positive, got {self.slug_weight_lbf!r}")
+        if self.model_kind not in KINDS:
+            raise ValueError(f"calibrate.model_kind must be one of {', '.join(KINDS)}, got {self.model_kind!r}")
+        if self.modal_mass is not None and not self.modal_mass > 0:
+            raise ValueError(f"calibrate.modal_mass must be positive (lbf s^2/in) or null, got {self.modal_mass!r}")
+        unknown = sorted(set(self.bounds) - set(PARAMS))
+        if unknown:
+            raise ValueError(f"calibrate.bounds: unknown parameter(s) {', '.join(unknown)}; they are "
+                             f"{', '.join(PARAMS)}")
         if self.n_polish < 0:
             raise ValueError(f"calibrate.n_polish must be >= 0, got {self.n_polish!r}")
         if self.curve_points < 2 or self.curve_widen < 1:
             raise ValueError("calibrate.curve_points must be >= 2 and curve_widen >= 1")
-        self.space  # validates the bounds
+        if self.model_kind == "ministack" or set(self.bounds) == set(PARAMS):
+            self.space  # validates the bounds
 
     @property
     def m(self) -> float:
-        """Slug mass, lbf s^2/in."""
+        """The moving mass, lbf s^2/in: the slug's (ministack), the given modal mass or 1 (modal)."""
+        if self.model_kind == "modal":
+            return 1.0 if self.modal_mass is None else float(self.modal_mass)
         return self.slug_weight_lbf / G
 
     @property
     def space(self) -> ParamSpace:
-        """The bounded parameter space."""
+        """The bounded parameter space: the config's bounds over the Ministack's defaults, or (modal) the
+        bounds `resolve` took from the data."""
+        if self.model_kind == "ministack":
+            return ParamSpace.from_bounds({**DEFAULT_BOUNDS, **self.bounds})
+        if set(self.bounds) != set(PARAMS):
+            raise ValueError(f"calibrate: the {self.model_kind} model's bounds come from the data; resolve the "
+                             "settings against the modal table (jointcal.calibrate.resolve) or the calibration's "
+                             "ga_best.json (CalibrateSettings.resolved) first.")
         return ParamSpace.from_bounds(self.bounds)
+
+    @property
+    def full_bounds(self) -> dict[str, list[float]]:
+        """All six bounds, {name: [lower, upper]} (physical units)."""
+        sp = self.space
+        return {n: [float(a), float(b)] for n, a, b in zip(sp.names, sp.lo, sp.hi)}
+
+    def resolved(self, best: Mapping[str, Any]) -> CalibrateSettings:
+        """These settings as the calibration that wrote ``best`` (its ga_best.json) resolved them: model
+        kind, mass and all six bounds (a ga_best.json from before model kinds: the Ministack's)."""
+        from dataclasses import replace
+
+        kind = best.get("model_kind", "ministack")
+        bounds = best.get("bounds") or {**DEFAULT_BOUNDS, **self.bounds}
+        mass = None if best.get("per_unit_modal_mass", True) else best.get("m")
+        return replace(self, model_kind=kind, bounds={k: list(map(float, v)) for k, v in bounds.items()},
+                       modal_mass=mass if kind == "modal" else self.modal_mass)
 
     @classmethod
     def from_config(cls, section: Mapping[str, Any] | None) -> CalibrateSettings:
@@ -101,6 +146,5 @@ class CalibrateSettings:
         if unknown:
             raise ValueError(f"calibrate: unknown key(s) {', '.join(unknown)}")
         ga = GAOptions(**{k: section.pop(k) for k in list(section) if k in _GA_KEYS})
-        bounds = {**DEFAULT_BOUNDS, **dict(section.pop("bounds", {}) or {})}
-        bounds = {k: [float(x) for x in v] for k, v in bounds.items()}
+        bounds = {k: [float(x) for x in v] for k, v in dict(section.pop("bounds", {}) or {}).items()}
         return cls(ga=ga, bounds=bounds, **section)

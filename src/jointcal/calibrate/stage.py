@@ -21,12 +21,15 @@ from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
 
+from dataclasses import replace
+
 from ..io import write_bytes_atomic, write_csv_atomic, write_json_atomic
-from .data import ModalData, read_modal
+from .data import ModalData, read_table, select_modal
 from .fit import Calibration, calibrate
+from .kind import data_bounds, excitation_of_table, kind_of
 from .settings import CalibrateSettings
 
-__all__ = ["OUTPUTS", "fingerprint", "run_calibration"]
+__all__ = ["OUTPUTS", "fingerprint", "resolve", "run_calibration"]
 
 OUTPUTS = ("ga_best.json", "ga_history.csv", "ga_logbook.csv", "model_curves.csv")
 
@@ -34,12 +37,41 @@ OUTPUTS = ("ga_best.json", "ga_history.csv", "ga_logbook.csv", "model_curves.csv
 def fingerprint(data: ModalData, s: CalibrateSettings) -> str:
     """SHA-256 of the data and the settings that change the GA's course."""
     ga = {k: v for k, v in asdict(s.ga).items() if k not in ("generations", "checkpoint_every")}
-    cfg = dict(model=s.model, viscous=s.viscous, damping=s.damping, eta=s.eta, m=s.m,
-               bounds={k: list(map(float, v)) for k, v in s.bounds.items()}, ga=ga)
+    cfg = dict(model=s.model, viscous=s.viscous, damping=s.damping, eta=s.eta, m=s.m, kind=s.model_kind,
+               bounds=s.full_bounds, ga=ga)
     h = hashlib.sha256(json.dumps(cfg, sort_keys=True).encode())
     for a in (data.q, data.f, data.zeta):
         h.update(a.tobytes())
     return h.hexdigest()
+
+
+def resolve(settings: CalibrateSettings, modal, assembly: str, *,
+            modal_name: object = "modal_properties.csv") -> tuple[CalibrateSettings, ModalData, str]:
+    """The settings made concrete for one assembly's data: model kind, mass and all six bounds.
+
+    Parameters
+    ----------
+    settings : CalibrateSettings
+        From the config (``model_kind`` may be 'auto', ``bounds`` partial).
+    modal : DataFrame
+        The modal stage's table.
+    assembly : str
+
+    Returns
+    -------
+    settings : CalibrateSettings (model_kind 'ministack' or 'modal', all six bounds)
+    data : ModalData
+    excitation : str ('base', 'force' or 'voltage')
+    """
+    excitation = excitation_of_table(modal)
+    kind = kind_of(settings.model_kind, excitation)
+    data = select_modal(modal, assembly, damping=settings.damping, modal_name=modal_name)  # type: ignore[arg-type]
+    s = replace(settings, model_kind=kind, bounds=dict(settings.bounds))
+    if kind == "modal":
+        s = replace(s, bounds={**data_bounds(data.q, data.f, data.zeta, s.m), **dict(settings.bounds)})
+    else:
+        s = replace(s, bounds=s.full_bounds)
+    return s, data, excitation
 
 
 def run_calibration(modal_csv: str | os.PathLike[str], assembly: str, out_dir: str | os.PathLike[str],
@@ -73,8 +105,11 @@ def run_calibration(modal_csv: str | os.PathLike[str], assembly: str, out_dir: s
     jointcal.calibrate.CalibrationInputError
         The modal table breaks its contract (one sentence naming the file).
     """
-    data = read_modal(modal_csv, assembly, damping=settings.damping)  # type: ignore[arg-type]
+    settings, data, excitation = resolve(settings, read_table(modal_csv), assembly, modal_name=Path(modal_csv))
     notes = list(data.notes)
+    notes.append(f"model kind {settings.model_kind} ({excitation}-driven runs), m = {settings.m:.6g} lbf s^2/in"
+                 + (" (per unit modal mass)" if settings.model_kind == "modal" and settings.modal_mass is None else "")
+                 + "; bounds " + ", ".join(f"{k} [{a:.3g}, {b:.3g}]" for k, (a, b) in settings.full_bounds.items()))
     fp = fingerprint(data, settings)
     resume = None
     ckpt = None if checkpoint is None else Path(checkpoint)
@@ -102,6 +137,8 @@ def run_calibration(modal_csv: str | os.PathLike[str], assembly: str, out_dir: s
                      + (f"; checkpoint {ckpt}" if ckpt is not None else ""))
 
     cal = calibrate(data, settings, resume=resume, on_checkpoint=None if ckpt is None and progress is None else save)
+    cal.best.update(model_kind=settings.model_kind, excitation=excitation, bounds=settings.full_bounds,
+                    per_unit_modal_mass=settings.model_kind == "modal" and settings.modal_mass is None)
     out = Path(out_dir)
     write_json_atomic(cal.best, out / "ga_best.json")
     write_csv_atomic(cal.history, out / "ga_history.csv")

@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from ..calibrate.data import CalibrationInputError, read_modal
+from ..calibrate.kind import model_words
 from ..calibrate.settings import CalibrateSettings
 from ..calibrate.space import PARAMS
 from ..io import write_bytes_atomic, write_csv_atomic
@@ -138,6 +139,7 @@ def run_posterior(modal_csv: str | os.PathLike[str], scatter_csv: str | os.PathL
                       floors=floors)
     notes = list(data.notes)
     best = json.loads(Path(ga_best_json).read_text())
+    cal = cal.resolved(best)  # the model kind, mass and bounds the calibration used
     for key in ("model", "viscous", "damping"):
         if best.get(key) != getattr(cal, key):
             raise CalibrationInputError(f"{ga_best_json}: it was calibrated with {key} {best.get(key)!r}, "
@@ -147,8 +149,7 @@ def run_posterior(modal_csv: str | os.PathLike[str], scatter_csv: str | os.PathL
     lp = LogPosterior(data, cal.space, cal.m, cal.model, cal.viscous, noise_max)
     y0 = start_ball(lp, theta, ps)
     shape = dict(theta=theta.tolist(), seed=ps.seed, walkers=ps.n_walkers, ball=ps.ball, floors=floors,
-                 noise_max=noise_max, cal=[cal.model, cal.viscous, cal.damping, cal.m,
-                                           {k: list(map(float, v)) for k, v in cal.bounds.items()}])
+                 noise_max=noise_max, cal=[cal.model, cal.viscous, cal.damping, cal.m, cal.full_bounds])
     fp = hashlib.sha256(json.dumps(shape, sort_keys=True).encode())
     for a in (data.q, data.f, data.zeta):
         fp.update(a.tobytes())
@@ -219,6 +220,8 @@ def run_posterior(modal_csv: str | os.PathLike[str], scatter_csv: str | os.PathL
     fit_ratio, fit_line = goodness_of_fit(lp, theta)
     text = (head + "\n" + fit_line + "\n" + modes_text(modes, PARAMS, converged=res.converged) + "\n"
             + constraints_text(summary, chain_x, burn=burn, q_max=float(data.q.max()), ratio=ps.constrained_ratio))
+    if cal.model_kind == "modal":  # what the numbers mean: per unit modal mass, the rig's mode for a voltage
+        text = text.rstrip("\n") + "\n" + model_words(best) + "\n"
     out = Path(out_dir)
     write_csv_atomic(summary, out / "summary.csv")
     final = arrays(res.chain, res.log_prob, res.random_state, res.tau_history, res.acceptance * res.steps)

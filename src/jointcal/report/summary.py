@@ -125,7 +125,8 @@ def _cell(text: str, cls: str = "") -> str:
 
 def table_3_2_html(table: pd.DataFrame, ga_points: Mapping[str, Mapping[str, float]],
                    modes: Mapping[str, pd.DataFrame] | None = None,
-                   bounds: Mapping[str, Sequence[float]] | None = None) -> str:
+                   bounds: Mapping[str, Sequence[float]] | Mapping[str, Mapping[str, Sequence[float]]] | None = None,
+                   model_notes: Mapping[str, str] | None = None) -> str:
     """Table 3.2 as an HTML table: per assembly, GA best, polished optimum, posterior, and each mode.
 
     Parameters
@@ -136,12 +137,19 @@ def table_3_2_html(table: pd.DataFrame, ga_points: Mapping[str, Mapping[str, flo
         `ga_best_point` of each assembly.
     modes : mapping assembly -> DataFrame, optional
         `jointcal.posterior.find_modes` tables; with two or more modes each gets a row.
-    bounds : mapping param -> (lo, hi), optional
-        Search bounds: values at a bound are marked.
+    bounds : mapping param -> (lo, hi), or assembly -> param -> (lo, hi), optional
+        Search bounds (one set, or each assembly's: a modal model's come from its data):
+        values at a bound are marked.
+    model_notes : mapping assembly -> str, optional
+        What the parameters mean for each assembly's model (`jointcal.calibrate.model_words`),
+        printed under the table where it is not the paper's Ministack.
     """
     head = "".join(f"<th>{p} ({html.escape(UNITS[p])})</th>" for p in PARAMS)
     rows = [f"<table><tr><th>assembly</th><th>estimate</th>{head}</tr>"]
+    all_bounds = bounds
     for name, g in table.groupby("assembly", sort=False):
+        bounds = (all_bounds.get(name) if all_bounds and isinstance(all_bounds.get(name), Mapping)
+                  else all_bounds)
         g = g.set_index("param")
         polished = {p: float(g.loc[p, "ga_optimum"]) for p in PARAMS}
         m = None if modes is None else modes.get(name)
@@ -170,6 +178,9 @@ def table_3_2_html(table: pd.DataFrame, ga_points: Mapping[str, Mapping[str, flo
             rows.append(f"<tr><td class='lab'>{html.escape(name)}</td><td class='lab'>mode {k + 1} ({w:.0f}% of the "
                         f"draws)</td>{''.join(cells)}</tr>")
     rows.append("</table>")
+    for name, words in (model_notes or {}).items():
+        if not words.startswith("The paper's Ministack"):
+            rows.append(f"<p><b>{html.escape(name)}</b>: {html.escape(words)}</p>")
     rows.append("<p>* not constrained by the data (posterior 90% interval spans at least half the prior range). "
                 "Orange: at a search bound. The GA best is the GA's own best individual; the polished optimum is "
                 "what least squares made of the best distinct individuals (<code>ga_best.json</code>) and is where the "

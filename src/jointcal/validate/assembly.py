@@ -10,7 +10,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import Executor
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
@@ -18,7 +18,8 @@ import pandas as pd
 
 from ..models import MinistackModel
 from .error import describe_misfit, envelope_error, repeat_scatter
-from .runs import band_frames, compare_run, draw_transmissibility, measure_pair
+from .runs import (band_frames, compare_run, draw_transmissibility, full_drive_fraction, measure_pair,
+                   reference_column, run_head, time_envelopes)
 
 __all__ = ["ValidateSettings", "Validation", "validate_runs"]
 
@@ -73,7 +74,8 @@ class Validation:
     metrics : one row per run (`compare_run` metrics + sim_s, process_s, draws_s times);
     frames : run_id -> `compare_run` frames (+ predictive-band columns when draws were given);
     scale : `repeat_scatter` table; error : `envelope_error` dict (E and its parts);
-    words : `describe_misfit` text.
+    words : `describe_misfit` text; traces : run_id -> `time_envelopes` (force- and voltage-driven
+    runs: the response envelope in time, measured and simulated).
     """
 
     metrics: pd.DataFrame
@@ -81,26 +83,30 @@ class Validation:
     scale: pd.DataFrame
     error: dict
     words: str
+    traces: dict[str, pd.DataFrame] = field(default_factory=dict)
 
 
 def _one_run(model: MinistackModel, record: pd.DataFrame, row: dict, draws: Sequence[MinistackModel],
              s: ValidateSettings, envelopes_kw: dict | None, modal_kw: dict | None):
     t0 = time.perf_counter()
     try:
-        (env_m, meta_m, props_m), (env_s, _, props_s) = measure_pair(model, record, row, envelopes_kw=envelopes_kw,
-                                                                     modal_kw=modal_kw)
+        (env_m, meta_m, props_m), (env_s, _, props_s), sim_record = measure_pair(
+            model, record, row, envelopes_kw=envelopes_kw, modal_kw=modal_kw, with_record=True)
     except ValueError as exc:  # a record the envelopes cannot process: reported, the other runs go on
-        head = {k: row[k] for k in ("run_id", "assembly", "sequence", "level_g", "direction") if k in row}
-        return pd.DataFrame(), {**head, "n_frames": 0, "note": str(exc)}
+        return pd.DataFrame(), {**run_head(row), "n_frames": 0, "note": str(exc)}, None
     t1 = time.perf_counter()
     frames, metrics = compare_run(env_m, props_m, env_s, props_s, band=s.band)
+    trace = None
+    if reference_column(record) != "base_accel_g" and np.isfinite(metrics.get("f_res_meas_hz", np.nan)):
+        trace = time_envelopes(record, sim_record, metrics["f_res_meas_hz"], float(row["sample_rate_hz"]))
     t2 = time.perf_counter()
     if draws and len(frames):
-        sel = band_frames(env_m, metrics["f_res_meas_hz"], s.band)
-        T = draw_transmissibility(draws, record, env_m, meta_m, sel, lead_s=s.lead_s)
+        fd = full_drive_fraction(props_m)
+        sel = band_frames(env_m, metrics["f_res_meas_hz"], s.band, full_drive=fd)
+        T = draw_transmissibility(draws, record, env_m, meta_m, sel, lead_s=s.lead_s, meta_row=row)
         T_m = ((env_m["resp_re"] + 1j * env_m["resp_im"]) / (env_m["ref_re"] + 1j * env_m["ref_im"])).to_numpy()[sel]
         pos = pd.Series(np.arange(len(frames)), index=np.flatnonzero(band_frames(env_m, metrics["f_res_meas_hz"],
-                                                                                 (0.0, np.inf))))
+                                                                                 (0.0, np.inf), full_drive=fd)))
         rows = pos.reindex(np.flatnonzero(sel)).to_numpy()
         keep = np.isfinite(rows)
         rows = rows[keep].astype(int)
@@ -113,7 +119,7 @@ def _one_run(model: MinistackModel, record: pd.DataFrame, row: dict, draws: Sequ
                 col[rows] = np.quantile(v, q, axis=0)
                 frames[f"{name}_q{round(q * 100):02d}_{unit}"] = col
     metrics.update(sim_s=t1 - t0, compare_s=t2 - t1, draws_s=time.perf_counter() - t2, n_draws=len(draws))
-    return frames, metrics
+    return frames, metrics, trace
 
 
 def validate_runs(models: Sequence[MinistackModel] | Callable[[dict], MinistackModel],
@@ -153,9 +159,11 @@ def validate_runs(models: Sequence[MinistackModel] | Callable[[dict], MinistackM
     per_draws = [list(draws(r)) if callable(draws) else list(draws) for r in rows]
     args = [(m, rec, r, d, settings, envelopes_kw, modal_kw) for m, rec, r, d in zip(per_run, records, rows, per_draws)]
     results = list(executor.map(_one_run, *zip(*args))) if executor is not None else [_one_run(*a) for a in args]
-    frames = {r["run_id"]: fr for r, (fr, _) in zip(rows, results)}
-    metrics = pd.DataFrame([mt for _, mt in results])
+    frames = {r["run_id"]: fr for r, (fr, _, _) in zip(rows, results)}
+    traces = {r["run_id"]: tr for r, (_, _, tr) in zip(rows, results) if tr is not None}
+    metrics = pd.DataFrame([mt for _, mt, _ in results])
     scale = repeat_scatter(frames, metrics, floor_db=settings.floor_db, floor_deg=settings.floor_deg)
     error = envelope_error(frames, metrics, scale)
-    return Validation(metrics=metrics, frames=frames, scale=scale, error=error,
-                      words=describe_misfit(metrics, error))
+    return Validation(metrics=metrics, frames=frames, scale=scale, error=error, traces=traces,
+                      words=describe_misfit(metrics, error, level_unit=next(
+                          (u for c, u in (("level_lbf", "lbf"), ("level_V", "V")) if c in metrics.columns), "g")))

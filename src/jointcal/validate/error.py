@@ -45,7 +45,7 @@ def repeat_scatter(frames: Mapping[str, pd.DataFrame], metrics: pd.DataFrame, *,
     frames : mapping run_id -> DataFrame
         `compare_run` frames (f_hz, mag_meas_db, phase_meas_deg, in_band).
     metrics : DataFrame
-        `compare_run` metrics (run_id, level_g, direction, f_res_meas_hz, zeta_meas).
+        `compare_run` metrics (run_id, level, direction, f_res_meas_hz, zeta_meas).
 
     Returns
     -------
@@ -55,7 +55,7 @@ def repeat_scatter(frames: Mapping[str, pd.DataFrame], metrics: pd.DataFrame, *,
     ss = np.zeros((len(BINS) - 1, 2))
     dof = np.zeros(len(BINS) - 1)
     ok = metrics[metrics["n_frames"] > 0]
-    for _, g in ok.groupby(["level_g", "direction"], sort=True):
+    for _, g in ok.groupby(["level", "direction"], sort=True):
         if len(g) < 2:
             continue
         fr = [frames[r][frames[r]["in_band"]] for r in g["run_id"]]
@@ -118,7 +118,7 @@ def envelope_error(frames: Mapping[str, pd.DataFrame], metrics: pd.DataFrame, sc
     frames : mapping run_id -> DataFrame
         `compare_run` frames.
     metrics : DataFrame
-        `compare_run` metrics (run_id, level_g, n_frames, f_res_meas_hz, zeta_meas).
+        `compare_run` metrics (run_id, level, n_frames, f_res_meas_hz, zeta_meas).
     scale : DataFrame
         `repeat_scatter`'s table.
 
@@ -135,7 +135,7 @@ def envelope_error(frames: Mapping[str, pd.DataFrame], metrics: pd.DataFrame, sc
         d = frames[r.run_id]
         d = d[d["in_band"]]
         b = _bin(_offset(d["f_hz"].to_numpy(), r.f_res_meas_hz, r.zeta_meas))
-        per_run.append((r.level_g, np.mean((d["d_mag_db"].to_numpy() / sm[b]) ** 2),
+        per_run.append((r.level, np.mean((d["d_mag_db"].to_numpy() / sm[b]) ** 2),
                         np.mean((d["d_phase_deg"].to_numpy() / sp[b]) ** 2)))
     if not per_run:
         raise ValueError("no usable run to validate: every run is unusable or has no frame in the band.")
@@ -167,7 +167,7 @@ def describe_misfit(metrics: pd.DataFrame, err: Mapping, *, level_unit: str = "g
     pr = float(np.nanmedian(m["peak_ratio"]))
     words.append(f"The model {'under' if pr < 1 else 'over'}-predicts the peak response by {_pct(pr - 1)} "
                  f"(median over {len(m)} runs; range {m['peak_ratio'].min():.3f} to {m['peak_ratio'].max():.3f}).")
-    lv = m.groupby("level_g")["f_res_rel_err"].median()
+    lv = m.groupby("level")["f_res_rel_err"].median()
     same = (np.sign(lv) == np.sign(lv.median())).all()
     words.append(f"Its resonance sits {_pct(lv.median())} {'high' if lv.median() > 0 else 'low'} (median"
                  + (", same sign at every level" if same else "; the sign changes with level")

@@ -1,11 +1,21 @@
-"""One run simulated with a model driven by its measured base record, and compared with the measurement.
+"""One run simulated with a model driven by its measured reference record, and compared with the measurement.
 
-The simulated record keeps the measured base channel exactly as recorded (NaN, DC offset
-and all) and replaces the response channel by the model's, so `jointcal.modal.measure_run`
-sees the same reference channel: the same drive ridge, frames, window and estimators for
-both records, and the processing bias cancels. The model is driven by the base record
-cleaned as `jointcal.signal.envelopes` cleans it (NaN gaps bridged linearly here, since
-the integrator needs a finite input; median removed).
+The simulated record keeps the measured reference channel exactly as recorded (NaN, DC
+offset and all) and replaces the response channel by the model's, so
+`jointcal.modal.measure_run` sees the same reference channel: the same drive ridge, frames,
+window and estimators for both records, and the processing bias cancels. The model is
+driven by the reference cleaned as `jointcal.signal.envelopes` cleans it (NaN gaps bridged
+linearly here, since the integrator needs a finite input; median removed):
+
+* base-driven (the Ministack): the base acceleration itself;
+* force- and voltage-driven (one mode, `jointcal.calibrate.kind`): the modal force per unit
+  modal mass A(w) r(t), the reference through the run's modal constant, a gain of the drive
+  frequency A(w) = A_c + A' (w - w_c) (held beyond +-45% of w_c) applied line by line to the
+  record's spectrum: 1/m for a force at the driving point; for an amplifier voltage the
+  rig's electrical and residual dynamics in one complex, frequency-sloped gain, measured by
+  the swept-mode fits (`jointcal.sweepfit`; the campaign's median, ``drive_gain`` in the
+  row). The calibrated mode (the rig's, back-EMF damping included) responds to it as to a
+  base acceleration -A r on a fixed base, and its acceleration is that response's.
 
 `draw_transmissibility` is the cheaper path for posterior draws (the predictive band
 only, never E): it simulates only the frames of the band (plus a tapered lead-in) and
@@ -22,35 +32,91 @@ import pandas as pd
 from numpy.typing import NDArray
 from scipy.signal.windows import hann
 
+from .._contract import REFERENCE
 from ..modal import measure_run
-from ..models import MinistackModel, simulate
+from ..models import G, MinistackModel, simulate
 
-__all__ = ["clean_base", "simulate_record", "band_frames", "compare_run", "measure_pair", "draw_transmissibility"]
+__all__ = ["clean_base", "reference_column", "drive_gain", "model_input", "simulate_record", "band_frames",
+           "compare_run", "measure_pair", "time_envelopes", "draw_transmissibility"]
 
 
-def clean_base(record: pd.DataFrame) -> NDArray[np.float64]:
-    """The base channel (g) as the model's input: NaN/inf bridged linearly, median removed, shape (N,)."""
-    x = record["base_accel_g"].to_numpy(dtype=float).copy()
+def reference_column(record: pd.DataFrame) -> str:
+    """The record's reference channel: base_accel_g, force_lbf or drive_V."""
+    cols = [c for c in REFERENCE.values() if c in record.columns]
+    if len(cols) != 1:
+        raise ValueError(f"a run record needs exactly one reference channel ({', '.join(REFERENCE.values())}); "
+                         f"it has {', '.join(map(str, record.columns))}.")
+    return cols[0]
+
+
+def clean_base(record: pd.DataFrame, column: str = "base_accel_g") -> NDArray[np.float64]:
+    """A reference channel as the model's input: NaN/inf bridged linearly, median removed, shape (N,)."""
+    x = record[column].to_numpy(dtype=float).copy()
     ok = np.isfinite(x)
     if not ok.any():
-        raise ValueError("the base channel holds no finite sample; the run cannot drive a simulation.")
+        raise ValueError(f"the {column} channel holds no finite sample; the run cannot drive a simulation.")
     if not ok.all():
         i = np.arange(x.size)
         x[~ok] = np.interp(i[~ok], i[ok], x[ok])
     return x - np.median(x)
 
 
-def simulate_record(model: MinistackModel, record: pd.DataFrame, row: Mapping) -> pd.DataFrame:
-    """The record the model would give: measured time and base columns, simulated response (g).
+def drive_gain(modal: pd.DataFrame) -> tuple[complex, complex, float] | None:
+    """The campaign's modal constant, (A_c, A' per rad/s, w_c rad/s): the median over the swept-mode fits.
 
-    Samples where the measured base is not finite are NaN in the simulated response too,
+    Each run's A (at its f_res_hz) is moved to the common w_c (the median resonance) along its own
+    slope; the median of the real and imaginary parts of A_c and A'. None without sweep fits.
+    """
+    need = ("modal_constant_re", "modal_constant_im", "modal_slope_re", "modal_slope_im", "f_res_hz")
+    if not all(c in modal.columns for c in need):
+        return None
+    ok = modal[list(need)].apply(pd.to_numeric, errors="coerce").dropna()
+    if ok.empty:
+        return None
+    w = 2 * np.pi * ok["f_res_hz"].to_numpy()
+    wc = float(np.median(w))
+    a = ok["modal_constant_re"].to_numpy() + 1j * ok["modal_constant_im"].to_numpy()
+    da = ok["modal_slope_re"].to_numpy() + 1j * ok["modal_slope_im"].to_numpy()
+    ac = a + da * (wc - w)
+    med = lambda z: complex(np.median(z.real), np.median(z.imag))  # noqa: E731
+    return med(ac), med(da), wc
+
+
+def _through_gain(r: NDArray, fs: float, gain: tuple[complex, complex, float]) -> NDArray:
+    """A(w) applied line by line to a real record (positive frequencies; the negative ones conjugate)."""
+    ac, da, wc = gain
+    n = 1 << int(np.ceil(np.log2(2 * r.size)))
+    w = 2 * np.pi * np.fft.rfftfreq(n, 1.0 / fs)
+    a = ac + da * np.clip(w - wc, -0.45 * wc, 0.45 * wc)
+    return np.fft.irfft(np.fft.rfft(r, n) * a, n)[:r.size]
+
+
+def model_input(record: pd.DataFrame, row: Mapping) -> tuple[NDArray[np.float64], str]:
+    """The model's input as a base acceleration (g), and the reference column (see the module docstring)."""
+    col = reference_column(record)
+    x = clean_base(record, col)
+    if col == REFERENCE["base"]:
+        return x, col
+    gain = row.get("drive_gain")
+    if gain is None:
+        raise ValueError(f"run {row.get('run_id', '?')}: a {col} reference drives the model through the mode's "
+                         "modal constant, and the modal stage found none (no swept-mode fit in the campaign); "
+                         "the run cannot be simulated.")
+    return -_through_gain(x, float(row["sample_rate_hz"]), gain) / G, col
+
+
+def simulate_record(model: MinistackModel, record: pd.DataFrame, row: Mapping) -> pd.DataFrame:
+    """The record the model would give: measured time and reference columns, simulated response (g).
+
+    Samples where the measured reference is not finite are NaN in the simulated response too,
     so the same frames are left out of both envelopes.
     """
-    if "base_accel_g" not in record.columns:
-        raise ValueError(f"run {row.get('run_id', '?')}: validation needs a base-driven record (base_accel_g).")
-    y = simulate(model, clean_base(record), float(row["sample_rate_hz"])).response_g
-    y[~np.isfinite(record["base_accel_g"].to_numpy(dtype=float))] = np.nan
-    out = record[["time_s", "base_accel_g"]].copy()
+    a_b, col = model_input(record, row)
+    y = simulate(model, a_b, float(row["sample_rate_hz"])).response_g
+    if col != REFERENCE["base"]:
+        y = y - a_b  # a fixed base forced by -m a_b: the mass's acceleration is the relative one
+    y[~np.isfinite(record[col].to_numpy(dtype=float))] = np.nan
+    out = record[["time_s", col]].copy()
     out["response_accel_g"] = y
     return out
 
@@ -59,11 +125,27 @@ def _transmissibility(env: pd.DataFrame) -> NDArray[np.complex128]:
     return ((env["resp_re"] + 1j * env["resp_im"]) / (env["ref_re"] + 1j * env["ref_im"])).to_numpy()
 
 
-def band_frames(env: pd.DataFrame, f_res_hz: float, band: Sequence[float]) -> NDArray[np.bool_]:
-    """Frames compared: drive on, not bad, at full drive (|base| >= 0.8 x median), f in band x f_res."""
+HEAD = ("run_id", "assembly", "sequence", "level_g", "level_lbf", "level_V", "direction")
+
+
+def run_head(row: Mapping) -> dict:
+    """A run's identity for the tables: run_id, assembly, sequence, its level column, direction, and
+    ``level``, the level in its own unit (g, lbf or V) whatever the reference."""
+    head = {k: row[k] for k in HEAD if k in row}
+    head["level"] = next((float(row[k]) for k in ("level_g", "level_lbf", "level_V") if k in row), np.nan)
+    return head
+
+
+def band_frames(env: pd.DataFrame, f_res_hz: float, band: Sequence[float], *,
+                full_drive: float = 0.8) -> NDArray[np.bool_]:
+    """Frames compared: drive on, not bad, at full drive (|reference| >= full_drive x median), f in band x f_res.
+
+    full_drive 0.8 leaves out a controlled drive's ramps (a ringing response over a vanishing
+    base); an open-loop force drops out at resonance by physics, and takes 0.05.
+    """
     ref = np.abs((env["ref_re"] + 1j * env["ref_im"]).to_numpy())
     on = env["drive_on"].to_numpy(bool) & ~env["bad"].to_numpy(bool)
-    full = ref >= 0.8 * np.median(ref[on]) if on.any() else on
+    full = ref >= full_drive * np.median(ref[on]) if on.any() else on
     f = env["f_drive_hz"].to_numpy()
     return on & full & (f >= band[0] * f_res_hz) & (f <= band[1] * f_res_hz)
 
@@ -82,8 +164,13 @@ def _phase_deg(T: NDArray) -> NDArray[np.float64]:
     return ph - 360.0 * np.round(ph[0] / 360.0) if ph.size else ph
 
 
+def full_drive_fraction(props: Mapping) -> float:
+    """`band_frames`' full-drive fraction for a run: 0.05 for a force reference, else 0.8."""
+    return 0.05 if "level_lbf" in props else 0.8
+
+
 def compare_run(env_m: pd.DataFrame, props_m: Mapping, env_s: pd.DataFrame, props_s: Mapping, *,
-                band: Sequence[float] = (0.8, 1.2), zeta_key: str = "zeta_phase_resonance"
+                band: Sequence[float] = (0.8, 1.2), zeta_key: str = "zeta_res"
                 ) -> tuple[pd.DataFrame, dict]:
     """Measured vs simulated envelope of one run, frame by frame, and the run's metrics.
 
@@ -108,12 +195,13 @@ def compare_run(env_m: pd.DataFrame, props_m: Mapping, env_s: pd.DataFrame, prop
         One row of metrics.csv (errors in dB, deg, and relative for f_res and zeta).
     """
     f_res = float(props_m["f_res_hz"])
-    head = {k: props_m[k] for k in ("run_id", "assembly", "sequence", "level_g", "direction") if k in props_m}
+    head = run_head(props_m)
+    fd = full_drive_fraction(props_m)
     if not np.isfinite(f_res) or "unusable" in str(props_m.get("flags", "")):
         return pd.DataFrame(), {**head, "n_frames": 0, "note": "measured run unusable"}
     lo, hi = band[0] * f_res, band[1] * f_res
-    use_m = band_frames(env_m, f_res, (0.0, np.inf))
-    use_s = band_frames(env_s, f_res, (0.0, np.inf))
+    use_m = band_frames(env_m, f_res, (0.0, np.inf), full_drive=fd)
+    use_s = band_frames(env_s, f_res, (0.0, np.inf), full_drive=fd)
     f = env_m["f_drive_hz"].to_numpy()[use_m]
     T_m = _transmissibility(env_m)[use_m]
     f_s = env_s["f_drive_hz"].to_numpy()[use_s]
@@ -153,17 +241,44 @@ def compare_run(env_m: pd.DataFrame, props_m: Mapping, env_s: pd.DataFrame, prop
 
 
 def measure_pair(model: MinistackModel, record: pd.DataFrame, row: Mapping, measured: tuple | None = None, *,
-                 envelopes_kw: dict | None = None, modal_kw: dict | None = None):
-    """measure_run on the measured record (unless given) and on the model's record: ((env, meta, props) x 2)."""
+                 envelopes_kw: dict | None = None, modal_kw: dict | None = None, with_record: bool = False):
+    """measure_run on the measured record (unless given) and on the model's record: ((env, meta, props) x 2)
+    (and the model's record, with ``with_record``)."""
     meas = measured if measured is not None else measure_run(record, dict(row), envelopes_kw=envelopes_kw,
                                                              modal_kw=modal_kw)
-    sim = measure_run(simulate_record(model, record, row), dict(row), envelopes_kw=envelopes_kw, modal_kw=modal_kw)
-    return meas, sim
+    sim_record = simulate_record(model, record, row)
+    sim = measure_run(sim_record, dict(row), envelopes_kw=envelopes_kw, modal_kw=modal_kw)
+    return (meas, sim, sim_record) if with_record else (meas, sim)
+
+
+def time_envelopes(record: pd.DataFrame, sim_record: pd.DataFrame, f_hz: float, fs: float, *,
+                   n_max: int = 2000) -> pd.DataFrame:
+    """Measured and simulated response envelopes in time near the mode (g), for transients.
+
+    A chirp faster than the mode (or its free decay) is not a sequence of steady states, and
+    the drive-frequency frames hold few points near resonance; the response's band-limited
+    envelope (`jointcal.sweepfit.baseband` at f_hz, low-passed at 0.45 f_hz) shows the passage
+    and the ring-down as they were. Columns time_s, resp_meas_g, resp_sim_g; at most n_max rows.
+    """
+    from ..sweepfit import baseband
+
+    out = {}
+    for name, rec in (("meas", record), ("sim", sim_record)):
+        a = rec["response_accel_g"].to_numpy(float)
+        good = np.isfinite(a)
+        a = np.where(good, a - np.median(a[good]), 0.0)
+        env = np.abs(baseband(a, fs, 2 * np.pi * f_hz, 0.45 * f_hz))
+        env[~good] = np.nan
+        out[f"resp_{name}_g"] = env
+    step = max(1, len(record) // n_max)
+    return pd.DataFrame({"time_s": record["time_s"].to_numpy(float)[::step],
+                         **{k: v[::step] for k, v in out.items()}})
 
 
 def draw_transmissibility(models: Sequence[MinistackModel], record: pd.DataFrame, env_m: pd.DataFrame,
-                          meta, frames: NDArray[np.bool_], *, lead_s: float = 0.1) -> NDArray[np.complex128]:
-    """Transmissibility response/base of many models on the measured frames `frames` (the cheap path).
+                          meta, frames: NDArray[np.bool_], *, lead_s: float = 0.1,
+                          meta_row: Mapping | None = None) -> NDArray[np.complex128]:
+    """Transmissibility response/reference of many models on the measured frames `frames` (the cheap path).
 
     Parameters
     ----------
@@ -177,6 +292,8 @@ def draw_transmissibility(models: Sequence[MinistackModel], record: pd.DataFrame
     lead_s : float
         Simulated time before the first frame's window, s; the input rises over its
         first half with a raised cosine, so the start-up transient has died out.
+    meta_row : mapping, optional
+        The run's row, for a force or voltage reference's ``drive_gain`` (`model_input`).
 
     Returns
     -------
@@ -186,23 +303,29 @@ def draw_transmissibility(models: Sequence[MinistackModel], record: pd.DataFrame
     if idx.size == 0:
         return np.zeros((len(models), 0), complex)
     fs, n, hop = meta.fs_hz, meta.n_window, int(round(meta.hop_s * meta.fs_hz))
-    base = clean_base(record)
+    base, col = model_input(record, {"sample_rate_hz": fs, **(meta_row or {})})
+    ref = base if col == REFERENCE["base"] else clean_base(record, col)
     lead = int(round(lead_s * fs))
     s0 = max(0, hop * idx[0] - lead)
     s1 = min(base.size, hop * idx[-1] + n)
     x = base[s0:s1].copy()
+    xr = ref[s0:s1].copy()
     ramp = min(lead // 2, hop * idx[0] - s0)
     if ramp > 1 and s0 > 0:
-        x[:ramp] *= 0.5 * (1 - np.cos(np.pi * np.arange(ramp) / ramp))
+        taper = 0.5 * (1 - np.cos(np.pi * np.arange(ramp) / ramp))
+        x[:ramp] *= taper
+        xr[:ramp] *= taper
     t = (s0 + np.arange(x.size)) / fs
     f_s = np.interp(t, env_m["time_s"].to_numpy(), env_m["f_drive_hz"].to_numpy())
     carrier = np.exp(-2j * np.pi * np.cumsum(f_s) / fs)
     win = hann(n, sym=False)
     starts = hop * idx - s0
     rows = starts[:, None] + np.arange(n)
-    B = (x * carrier)[rows] @ win
+    B = (xr * carrier)[rows] @ win
     out = np.empty((len(models), idx.size), complex)
     for i, model in enumerate(models):
         y = simulate(model, x, fs).response_g
+        if col != REFERENCE["base"]:
+            y = y - x
         out[i] = ((y * carrier)[rows] @ win) / B
     return out

@@ -1,0 +1,51 @@
+"""Real records from another lab, end to end (opt-in: ``pytest -m acceptance``; skipped without the data).
+
+The UNESP-BERT bolted beam's mode 1 (six voltage-driven up chirps at eta 200-600; SHM Lab, UNESP
+Ilha Solteira, non-commercial research use) lives outside this repository, in
+../shared/real/unesp-bert-mode1 beside it, and is never copied in. The whole workflow runs on it
+with the default config: the model kind follows the excitation (one mode, per unit modal mass, its
+bounds from the data), and the calibrated curve passes within 0.2% of every run's (q_in, f_res_hz).
+"""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from _campaign import workflow_copy
+from jointcal.calibrate import DEFAULT_BOUNDS
+
+REAL = Path(__file__).resolve().parents[2] / "shared" / "real" / "unesp-bert-mode1"
+
+pytestmark = [pytest.mark.acceptance,
+              pytest.mark.skipif(not (REAL / "manifest.csv").is_file(),
+                                 reason=f"the real records are not at {REAL} (they are not part of the repository)")]
+
+
+def test_a_voltage_driven_real_campaign_runs_end_to_end_with_the_default_config(tmp_path):
+    work, out = workflow_copy(tmp_path), tmp_path / "results"
+    res = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", "--config", f"raw_data={REAL}",
+                          f"results={out}"], cwd=work, capture_output=True, text=True, timeout=1800)
+    assert res.returncode == 0, res.stderr[-3000:]
+    best = json.loads((out / "calibration" / "bert_5Nm" / "ga_best.json").read_text())
+    assert best["model_kind"] == "modal" and best["excitation"] == "voltage" and best["per_unit_modal_mass"]
+    assert best["m"] == 1.0
+    assert all(best["bounds"][p] != DEFAULT_BOUNDS[p] for p in ("Fs", "KT", "k"))  # from the data
+    modal = pd.read_csv(out / "modal" / "modal_properties.csv")
+    assert (modal["f_res_method"] == "sweep_fit").all()
+    curve = pd.read_csv(out / "calibration" / "bert_5Nm" / "model_curves.csv")
+    curve = curve[curve["model"] == best["model"]]
+    f_model = np.interp(np.log(modal["q_in"]), np.log(curve["q_in"]), curve["f_hz"])
+    err = f_model / modal["f_res_hz"] - 1
+    print("\ncalibrated curve vs each run's (q_in, f_res_hz):", ", ".join(f"{100 * e:+.3f}%" for e in err))
+    assert np.abs(err).max() < 2e-3
+    summary = json.loads((out / "validation" / "bert_5Nm" / "summary.json").read_text())
+    assert np.isfinite(summary["E"]) and "modal constant" in summary["words"]
+    assert any((out / "validation" / "bert_5Nm" / "envelopes" / "traces").glob("*.csv"))
+    assert "per unit modal mass" in (out / "posterior" / "bert_5Nm" / "constraints.txt").read_text()
+    assert not (out / "discrepancy").exists()  # the base-driven rig's library is not run on a voltage campaign
