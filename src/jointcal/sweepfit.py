@@ -46,8 +46,8 @@ information criterion of the misfit asks for it (a curvature fitted to noise ben
 backbone's ends: +0.14% at q_in on a jointed beam at eta 500); the damping's carries a
 ridge (`curv`). The fit
 (`scipy.optimize.least_squares`: the modal constant, the shape coefficients, Omega and D at
-q_ref, phi in [0, 1], and residual terms B_0 R - i B_1 R' / W_0 for the other modes' mass
-or stiffness lines)
+q_ref, phi in [0, 1], and residual terms (B_0 + B_1 (w / W_0 - 1) + B_2 (w / W_0 - 1)^2) r_a for
+the other modes' mass or stiffness lines)
 returns Omega and zeta = D / (2 Omega) at the largest amplitude the fitted response
 reached, `q_in`: the equivalent-linear resonance and damping at the amplitude the
 structure reached, and the backbone below it.
@@ -207,7 +207,7 @@ def _window(mag: NDArray, ok: NDArray[np.bool_], frac: float, quiet: float,
 def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: float, *,
                    modal_phase: float | None = None, window: float = 0.15, cutoff: float = 0.45,
                    steps_per_cycle: float = 6.0, quiet: float = 0.02, ridge: float = 0.01,
-                   curv: float = 0.3) -> SweepFit:
+                   curv: float = 0.3, residual_ridge: float = 0.3) -> SweepFit:
     """Fit one amplitude-dependent mode to a swept run (see the module docstring).
 
     Parameters
@@ -245,6 +245,10 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
         Weight of a ridge penalty on the nuisance terms (the modal constant's slope over its
         value, the residual terms over the peak): a value of 1 costs as much as a relative
         misfit of `ridge` on every sample.
+    residual_ridge : float
+        The residual terms' share of that penalty (0.3: other modes' lines must be free enough to
+        follow a second mode's stiffness line over the band, whose curvature biased the resonance
+        by +0.05-0.1% on a jointed beam at eta 500 with only the constant and slope terms).
     curv : float
         The same penalty, times curv, on the curvature of ln D in L over the window
         (b2 L_lo^2): the damping is a power law in q unless the data ask for more (measured
@@ -290,13 +294,14 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
     Rh = R[::half]  # the drive at every half step: RK4's midpoints see it exactly, not interpolated
     Rh = _bridge(Rh, bad_R[::half])
     Rdh = np.gradient(Rh, h / 2)
-    R, Rd = Rh[::2], Rdh[::2]
+    Rddh = np.gradient(Rdh, h / 2)
+    R, Rd, Rdd = Rh[::2], Rdh[::2], Rddh[::2]
     Rm, Rdm = Rh[1::2], Rdh[1::2]
     Acc, bad_A = Acc[::2 * half][:R.size], bad_A[::2 * half][:R.size]
     mag = np.abs(Acc)
     ok = ~bad_A
     i_start, i0, i1 = _window(mag, ok, window, quiet)
-    R, Rd, Acc, ok, mag = (x[i_start:i1 + 1] for x in (R, Rd, Acc, ok, mag))
+    R, Rd, Rdd, Acc, ok, mag = (x[i_start:i1 + 1] for x in (R, Rd, Rdd, Acc, ok, mag))
     Rm, Rdm = Rm[i_start:i1], Rdm[i_start:i1]
     win = ok & (np.arange(mag.size) >= i0 - i_start)
     # the misfit on every third step (2 samples per cycle at f0): the envelopes are band-limited below
@@ -324,50 +329,56 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
 
     fixed = modal_phase is not None  # a force at the driving point: A = |A| e^{i phase}, no slope; real residuals
     rot = np.exp(1j * modal_phase) if fixed else 1.0
-    free_all = np.array([0, 1, 2, 3, 4, 5, 6, 8, 11, 13, 15] if fixed else list(range(16)))
+    free_all = np.array([0, 1, 2, 3, 4, 5, 6, 8, 11, 13, 15, 16] if fixed else list(range(18)))
     free = free_all[~np.isin(free_all, (3, 15))]  # ln Omega^2 linear in L first; its curvature if the data ask
 
     def params(pf):
-        p = np.zeros(16)
+        p = np.zeros(18)
         p[free] = pf
         a = p[6] * rot if fixed else p[6] + 1j * p[7]
         mode = np.array([W0**2 * np.exp(2 * p[0]), 2 * zeta0 * W0 * np.exp(p[1]), p[2], p[3], p[4], p[5],
                          a.real * a_abs, a.imag * a_abs, p[8], p[9] * a_abs, p[10] * a_abs, p[15]])
-        return mode, b_abs * complex(p[11], p[12]), b_abs * complex(p[13], p[14])
+        return mode, b_abs * np.array([complex(p[11], p[12]), complex(p[13], p[14]), complex(p[16], p[17])])
 
     def response(pf):
-        mode, b0, b1 = params(pf)
+        mode, b = params(pf)
         Z, acc = _rotating_mode(R, Rd, Rm, Rdm, W0, h, mode, q_ref, l_lo, l_hi, z_start, y_start)
-        return Z, acc + b0 * R - 1j * b1 * Rd / W0  # residual terms: the other modes' mass or stiffness line
+        return Z, acc + residual_basis @ b  # residual terms: the other modes' mass or stiffness lines
 
     weight = ridge * np.sqrt(sel.sum())
+    # the residual terms' basis: (w / W0 - 1)^k R for k = 0, 1, 2 in the frame (w R -> W0 R - i R')
+    residual_basis = np.stack([R, -1j * Rd / W0, -Rdd / W0**2], axis=1)
 
     def misfit(pf):
         with np.errstate(all="ignore"):  # a trial step may diverge: a large misfit, not a warning
             res = (response(pf)[1] - Acc)[sel] / peak
         res = np.where(np.isfinite(res) & (np.abs(res) < 1e3), res, 1e3)
-        p = np.zeros(16)
+        p = np.zeros(18)
         p[free] = pf
         # a ridge on the nuisance terms (the modal constant's slope relative to it, the residual terms
         # relative to the peak): they stay small unless the data ask for them (an impulse-like chirp
         # cannot tell a feedthrough from the mode's response while the drive passes)
-        nuisance = np.concatenate([p[9:11] / max(np.hypot(p[6], p[7]), 1e-12), p[11:15]])[free[(free >= 9) & (free < 15)] - 9]
+        nuisance = np.concatenate([p[9:11] / max(np.hypot(p[6], p[7]), 1e-12),
+                                   residual_ridge * np.concatenate([p[11:15], [0.0], p[16:18]])])
+        nuisance = nuisance[free[free >= 9] - 9]
         curvature = curv * p[5] * l_lo**2  # the damping's quadratic term's change over the window
         return np.concatenate([res.real, res.imag, weight * nuisance, [weight * curvature]])
 
-    x_scale = np.array([1e-3, 0.1, 0.01, 0.01, 0.2, 0.2, 0.1, 0.1, 0.2, 0.5, 0.5, 0.01, 0.01, 0.01, 0.01, 0.01])
-    lower = np.full(16, -np.inf)
-    upper = np.full(16, np.inf)
+    x_scale = np.array([1e-3, 0.1, 0.01, 0.01, 0.2, 0.2, 0.1, 0.1, 0.2, 0.5, 0.5, 0.01, 0.01, 0.01, 0.01, 0.01,
+                        0.01, 0.01])
+    lower = np.full(18, -np.inf)
+    upper = np.full(18, np.inf)
     lower[8], upper[8] = 0.0, 1.0
     norm = np.linalg.norm(Acc[sel] / peak)
     n_res = 2 * int(sel.sum())
     best, rel = None, np.inf
-    for f_s, z_s, a_s, b0_s, b1_s in _starts(R, Rd, Rm, Rdm, Acc, sel, h, W0, f0, zeta0, fixed, rot):
-        p0 = np.zeros(16)
+    for f_s, z_s, a_s, b0_s, b1_s, b2_s in _starts(R, Rd, Rm, Rdm, Rdd, Acc, sel, h, W0, f0, zeta0, fixed, rot):
+        p0 = np.zeros(18)
         p0[:2] = np.log(f_s / f0), np.log(z_s * f_s / (zeta0 * f0))
         a_s = a_s / a_abs / rot
         p0[6], p0[7], p0[8] = a_s.real, (0.0 if fixed else a_s.imag), 0.5
         p0[11:15] = (b0_s.real / b_abs, b0_s.imag / b_abs, b1_s.real / b_abs, b1_s.imag / b_abs)
+        p0[16:18] = (b2_s.real / b_abs, b2_s.imag / b_abs)
         sol = least_squares(misfit, p0[free], x_scale=x_scale[free], bounds=(lower[free], upper[free]), max_nfev=100)
         if best is None or sol.cost < best.cost:
             best, rel = sol, float(np.linalg.norm(sol.fun[:n_res]) / norm)  # relative RMS misfit: SweepFit.residual
@@ -375,7 +386,7 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
             break
     # the frequency's curvature (a2, a3) where the data ask for it: Bayesian information criterion on the
     # misfit, with half the samples counted (the low-passed envelopes are correlated over two of them)
-    p_lin = np.zeros(16)
+    p_lin = np.zeros(18)
     p_lin[free] = best.x
     free_lin, free = free, free_all
     curved = least_squares(misfit, p_lin[free], x_scale=x_scale[free], bounds=(lower[free], upper[free]),
@@ -386,7 +397,7 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
         best, rel = curved, float(np.sqrt(rss_cur) / norm)
     else:
         free = free_lin
-    mode, _, _ = params(best.x)
+    mode, _ = params(best.x)
     Z, _ = response(best.x)
     q_top = float(np.abs(Z[win]).max())
     coef = (*(float(v) for v in mode[:6]), float(mode[8]), q_ref, l_lo, l_hi, float(mode[11]))
@@ -397,42 +408,43 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
     return SweepFit(**{**fit.__dict__, "f_hz": float(f), "zeta": float(z)})
 
 
-def _linear_mode(R, Rd, Rm, Rdm, Acc, sel, h, W0, f, z, fixed, rot):
-    """(misfit norm, A, B_0, B_1) of a linear mode (f Hz, zeta): its modal constant and residual terms
-    by linear least squares (complex; real projections for a fixed phase)."""
+def _linear_mode(R, Rd, Rm, Rdm, Rdd, Acc, sel, h, W0, f, z, fixed, rot):
+    """(misfit norm, A, B_0, B_1, B_2) of a linear mode (f Hz, zeta): its modal constant and residual
+    terms by linear least squares (complex; real projections for a fixed phase)."""
     mode = np.array([(2 * np.pi * f) ** 2, 4 * np.pi * f * z, 0, 0, 0, 0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0])
     with np.errstate(all="ignore"):
         x = _rotating_mode(R, Rd, Rm, Rdm, W0, h, mode, 1.0, -1.0, 1.0, 0j, 0j)[1][sel]
     if not np.all(np.isfinite(x)):
-        return np.inf, 1.0 + 0j, 0j, 0j
-    cols = np.stack([x, R[sel], -1j * Rd[sel] / W0], axis=1)
+        return np.inf, 1.0 + 0j, 0j, 0j, 0j
+    cols = np.stack([x, R[sel], -1j * Rd[sel] / W0, -Rdd[sel] / W0**2], axis=1)
     y = Acc[sel]
     if fixed:  # real coefficients of (A e^{-i phase}) x, R, -i R'/W0
-        cols = cols * np.array([rot, 1.0, 1.0])
+        cols = cols * np.array([rot, 1.0, 1.0, 1.0])
         c, *_ = np.linalg.lstsq(np.concatenate([cols.real, cols.imag]), np.concatenate([y.real, y.imag]), rcond=None)
         c = c.astype(complex)
         c[0] = c[0] * rot
     else:
         c, *_ = np.linalg.lstsq(cols, y, rcond=None)
-    return float(np.linalg.norm(y - np.stack([x, R[sel], -1j * Rd[sel] / W0], axis=1) @ c)), *map(complex, c)
+    full = np.stack([x, R[sel], -1j * Rd[sel] / W0, -Rdd[sel] / W0**2], axis=1)
+    return float(np.linalg.norm(y - full @ c)), *map(complex, c)
 
 
-def _starts(R, Rd, Rm, Rdm, Acc, sel, h, W0, f0, zeta0, fixed, rot, n_keep=3):
-    """Start values (f Hz, zeta, A, B_0, B_1) of the nonlinear fit, lazily: the caller's (f0, zeta0) first; then,
+def _starts(R, Rd, Rm, Rdm, Rdd, Acc, sel, h, W0, f0, zeta0, fixed, rot, n_keep=3):
+    """Start values (f Hz, zeta, A, B_0, B_1, B_2) of the nonlinear fit, lazily: the caller's (f0, zeta0) first; then,
     only if the fit from it is poor, a scan of linear modes over frequencies within +-5% of f0 (or 4
     half-power widths) and damping ratios from zeta0 / 10 to 10 zeta0 (a chirp faster than the mode, or
-    a bent peak, can put an FRF's damping a decade off), the n_keep best distinct ones. A, B_0 and B_1
-    start from each linear mode's least squares."""
-    args = (R, Rd, Rm, Rdm, Acc, sel, h, W0)
+    a bent peak, can put an FRF's damping a decade off), the n_keep best distinct ones. A and the
+    residual terms start from each linear mode's least squares."""
+    args = (R, Rd, Rm, Rdm, Rdd, Acc, sel, h, W0)
     yield f0, zeta0, *_linear_mode(*args, f0, zeta0, fixed, rot)[1:]
     df = min(0.05, max(4 * zeta0, 0.002))
     rows = [(*_linear_mode(*args, f, z, fixed, rot), f, z)
             for f in f0 * (1 + df * np.linspace(-1, 1, 9)) for z in zeta0 * np.geomspace(0.1, 10.0, 11) if 0 < z < 0.5]
     rows.sort(key=lambda r: r[0])
     kept = [(f0, zeta0)]
-    for _, a, b0, b1, f, z in rows:
+    for _, a, b0, b1, b2, f, z in rows:
         if all(abs(f / g - 1) > df / 8 or abs(np.log(z / w)) > 0.3 for g, w in kept):
             kept.append((f, z))
-            yield f, z, a, b0, b1
+            yield f, z, a, b0, b1, b2
         if len(kept) > n_keep:
             break
