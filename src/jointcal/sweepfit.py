@@ -53,8 +53,9 @@ reached, `q_in`: the equivalent-linear resonance and damping at the amplitude th
 structure reached, and the backbone below it.
 
 Bad samples (NaN or inf) in either channel are left out: the response's frames within a
-filter length of them leave the misfit, and the drive's demodulated envelope (smooth near
-the mode) is bridged across them by shape-preserving interpolation.
+filter length of them leave the misfit, and the drive's demodulated envelope is bridged
+across them as the swept sine it is (a quadratic phase and a log-linear magnitude fitted on
+both sides).
 """
 from __future__ import annotations
 
@@ -64,7 +65,6 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 from scipy import signal
-from scipy.interpolate import PchipInterpolator
 from scipy.optimize import least_squares
 
 from .models import G
@@ -169,17 +169,45 @@ def _dilate(bad: NDArray[np.bool_], n: int) -> NDArray[np.bool_]:
     return np.convolve(bad.astype(float), np.ones(2 * n + 1), mode="same") > 0.5
 
 
+def _runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
+    """[start, stop) of each run of True in mask."""
+    d = np.diff(np.concatenate([[0], mask.astype(int), [0]]))
+    return list(zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1)))
+
+
 def _bridge(x: NDArray, bad: NDArray[np.bool_]) -> NDArray:
-    """x with its bad samples replaced by a shape-preserving (PCHIP) interpolation of the good ones."""
+    """A swept drive's complex envelope across its bad stretches: a chirp in the frame.
+
+    On the good samples beside each bad stretch (as many as it is long, on each side) the phase
+    is fitted by a quadratic in time (a linear sweep's phase, unwrapped across the stretch by the
+    whole number of turns its two sides' slopes predict) and the log-magnitude by a line; the
+    stretch takes their values. A stretch with one good side keeps that side's extrapolation.
+    """
     if not bad.any():
         return x
-    good = np.flatnonzero(~bad)
-    if good.size < 2:
-        raise ValueError("the drive channel has fewer than two good samples near the mode.")
-    i = np.flatnonzero(bad)
+    if (~bad).sum() < 8:
+        raise ValueError("the drive channel has too few good samples near the mode.")
     out = x.copy()
-    out[i] = (PchipInterpolator(good, x.real[good], extrapolate=True)(i)
-              + 1j * PchipInterpolator(good, x.imag[good], extrapolate=True)(i))
+    idx = np.arange(x.size)
+    for a, b in _runs(bad):
+        n = max(b - a, 8)
+        sides = [s for s in (idx[max(0, a - n):a], idx[b:b + n]) if s.size >= 4 and np.all(~bad[s])]
+        sides = [s[np.abs(x[s]) > 0] for s in sides]
+        sides = [s for s in sides if s.size >= 4]
+        if not sides:
+            raise ValueError("a bad stretch of the drive has no good samples beside it to bridge it from.")
+        t0 = 0.5 * (a + b)
+        phases = [np.unwrap(np.angle(x[s])) for s in sides]
+        if len(sides) == 2:  # the right side's turns counted from the left side's extrapolation
+            cl = np.polyfit(sides[0] - t0, phases[0], min(2, sides[0].size - 2))
+            guess = np.polyval(cl, sides[1][0] - t0)
+            phases[1] += 2 * np.pi * np.round((guess - phases[1][0]) / (2 * np.pi))
+        t = np.concatenate(sides) - t0
+        deg = 2 if t.size >= 8 else 1
+        ph = np.polyfit(t, np.concatenate(phases), deg)
+        lm = np.polyfit(t, np.log(np.abs(x[np.concatenate(sides)])), 1)
+        tt = idx[a:b] - t0
+        out[a:b] = np.exp(np.polyval(lm, tt) + 1j * np.polyval(ph, tt))
     return out
 
 
