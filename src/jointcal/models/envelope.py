@@ -75,6 +75,41 @@ def _field(value, shape) -> NDArray[np.float64]:
     return np.ascontiguousarray(a.reshape(-1, shape[-1])[:, 0])
 
 
+def _batch_shape(model: MinistackModel, f_shape: tuple) -> tuple[tuple[int, int], tuple]:
+    """(P, N) of a model's parameter batch along frequencies of shape f_shape, and the broadcast output shape."""
+    iw = model.iwan
+    fields = [model.m, model.k, model.zeta_v, model.k3, model.c2, model.sensor_gain, model.sensor_delay_s]
+    if iw is not None:
+        fields += [iw.Fs, iw.KT, iw.chi, iw.beta]
+    if model.fixture is not None:
+        fields += [model.fixture.m_can, model.fixture.f_can, model.fixture.zeta_can]
+    out_shape = np.broadcast_shapes(*(np.shape(v) for v in fields), f_shape)
+    return (int(np.prod(out_shape[:-1], dtype=int)), out_shape[-1]), out_shape
+
+
+def _joint_terms(model: MinistackModel, shape) -> tuple[NDArray, ...]:
+    """The joint DOF's kernel parameters, each (P,): k, c, KT, R, chi, phi_max, S, J(chi, 1), k3, c2.
+
+    c = 2 zeta_v sqrt((k + KT) m) is the dashpot (lbf s/in); R, S, phi_max the Iwan density
+    parameters (`iwan.derived`); a linear model has KT = 0.
+    """
+    P = shape[0]
+    m, k, zv = (_field(v, shape) for v in (model.m, model.k, model.zeta_v))
+    k3, c2 = _field(model.k3, shape), _field(model.c2, shape)
+    iw = model.iwan
+    if iw is None:
+        KT = np.zeros(P)
+        R = S = J1 = np.zeros(P)
+        chi = np.full(P, -0.5)
+        phimax = np.ones(P)
+    else:
+        Fs, KT, chi, beta = (_field(v, shape) for v in (iw.Fs, iw.KT, iw.chi, iw.beta))
+        phimax, R, S = derived(Fs, KT, chi, beta)
+        J1 = _J(chi, np.ones_like(chi))
+    c = 2.0 * zv * np.sqrt((k + KT) * m)
+    return k, c, KT, R, chi, phimax, S, J1, k3, c2
+
+
 def _structure_terms(model: MinistackModel, w: NDArray, shape) -> tuple[NDArray, NDArray]:
     """Effective inertia mu (P, N) and base-load factor gamma (P, N) seen by the joint DOF.
 
@@ -137,29 +172,12 @@ def steady_state(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike = 1.0
     if np.any(np.asarray(model.contact_k) != 0):
         raise ValueError("steady_state has no first-harmonic model of a unilateral contact (contact_k > 0): its "
                          "response has a mean offset and even harmonics; use jointcal.models.simulate.")
-    iw = model.iwan
-    fields = [model.m, model.k, model.zeta_v, model.k3, model.c2, model.sensor_gain, model.sensor_delay_s]
-    if iw is not None:
-        fields += [iw.Fs, iw.KT, iw.chi, iw.beta]
-    if model.fixture is not None:
-        fields += [model.fixture.m_can, model.fixture.f_can, model.fixture.zeta_can]
-    shape = np.broadcast_shapes(*(np.shape(v) for v in fields), f.shape)
-    out_shape = shape
-    shape = (int(np.prod(shape[:-1], dtype=int)), shape[-1])
+    shape, out_shape = _batch_shape(model, f.shape)
     P = shape[0]
     w = 2 * np.pi * f
-    m, k, zv = (_field(v, shape) for v in (model.m, model.k, model.zeta_v))
-    k3, c2 = _field(model.k3, shape), _field(model.c2, shape)
-    if iw is None:
-        KT = np.zeros(P)
-        R = S = J1 = np.zeros(P)
-        chi = np.full(P, -0.5)
-        phimax = np.ones(P)
-    else:
-        Fs, KT, chi, beta = (_field(v, shape) for v in (iw.Fs, iw.KT, iw.chi, iw.beta))
-        phimax, R, S = derived(Fs, KT, chi, beta)
-        J1 = _J(chi, np.ones_like(chi))
-    c = 2.0 * zv * np.sqrt((k + KT) * m)
+    joint = _joint_terms(model, shape)
+    k, c, KT, R, chi, phimax, S, J1, k3, c2 = joint
+    m = _field(model.m, shape)
     mu, gamma = _structure_terms(model, w, shape)
     rigid = model.fixture is None  # gamma = 1, mu real: skip the complex work
     logB = np.log(m[:, None] * A) + (0.0 if rigid else np.log(np.abs(gamma)))
