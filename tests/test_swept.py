@@ -90,7 +90,7 @@ def test_integrated_envelope_matches_a_time_simulated_sweep(eta):
         x = (f[on] / f_res - 1) / zeta
         near = np.abs(x) < 6
         T = swept_transmissibility(model, drive, t[on], f_res_hz=f_res, zeta=zeta)
-        r = drive.rates()
+        r = drive.rates
         Tq = quasi_steady(model, f[on], b[on], rate_hz_per_s=r[0], direction="up" if fb > fa else "down")
         err_db = np.abs(20 * np.log10(np.abs(T / T_sim[on])))[near]
         err_deg = np.abs(np.degrees(np.angle(T / T_sim[on])))[near]

@@ -110,6 +110,37 @@ def _joint_terms(model: MinistackModel, shape) -> tuple[NDArray, ...]:
     return k, c, KT, R, chi, phimax, S, J1, k3, c2
 
 
+def _amplitudes(f: NDArray, A: NDArray, direction: str, shape, joint, m: NDArray, mu: NDArray,
+                gamma: NDArray | None) -> tuple[NDArray, ...]:
+    """The kernel's continuation along the sweep: s = log q, jump flags and K_z = kre + i kim, each (P, N).
+
+    joint : `_joint_terms`; m (P,); mu (P, N) and gamma (P, N) or None (rigid base) from
+    `_structure_terms`; A (N,) base amplitude, in/s^2.
+    """
+    P = shape[0]
+    w = 2 * np.pi * f
+    k, c, KT, R, chi, phimax, S, J1, k3, c2 = joint
+    rigid = gamma is None
+    logB = np.log(m[:, None] * A) + (0.0 if rigid else np.log(np.abs(gamma)))
+    order = np.argsort(f, kind="stable")
+    if direction == "down":
+        order = order[::-1]
+    n0 = order[0]
+    stuck = k + KT + 1j * w[n0] * c
+    g0 = 1.0 if rigid else np.abs(gamma[:, n0])
+    s0 = np.log(g0 * m * A[n0] / np.abs(stuck - mu[:, n0]))
+    s = np.empty((P, f.size))
+    jump = np.zeros((P, f.size), dtype=np.bool_)
+    kre, kim = np.empty((P, f.size)), np.empty((P, f.size))
+    solver = _k.solve_parallel if P >= 64 else _k.solve  # threads pay off only for large batches
+    mu_re = np.ascontiguousarray(mu.real)
+    mu_im = np.zeros_like(mu_re) if rigid else np.ascontiguousarray(mu.imag)
+    solver(w, mu_re, mu_im, np.ascontiguousarray(np.broadcast_to(logB, (P, f.size))), s0,
+           order.astype(np.int64), k, c, KT, R, chi, phimax, S, J1, k3, c2, _NODES, _WEIGHTS, TOL, s, jump,
+           kre, kim)
+    return s, jump, kre, kim
+
+
 def _structure_terms(model: MinistackModel, w: NDArray, shape) -> tuple[NDArray, NDArray]:
     """Effective inertia mu (P, N) and base-load factor gamma (P, N) seen by the joint DOF.
 
@@ -175,28 +206,11 @@ def steady_state(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike = 1.0
     shape, out_shape = _batch_shape(model, f.shape)
     P = shape[0]
     w = 2 * np.pi * f
-    joint = _joint_terms(model, shape)
-    k, c, KT, R, chi, phimax, S, J1, k3, c2 = joint
     m = _field(model.m, shape)
     mu, gamma = _structure_terms(model, w, shape)
     rigid = model.fixture is None  # gamma = 1, mu real: skip the complex work
-    logB = np.log(m[:, None] * A) + (0.0 if rigid else np.log(np.abs(gamma)))
-    order = np.argsort(f, kind="stable")
-    if direction == "down":
-        order = order[::-1]
-    n0 = order[0]
-    stuck = k + KT + 1j * w[n0] * c
-    g0 = 1.0 if rigid else np.abs(gamma[:, n0])
-    s0 = np.log(g0 * m * A[n0] / np.abs(stuck - mu[:, n0]))
-    s = np.empty((P, f.size))
-    jump = np.zeros((P, f.size), dtype=np.bool_)
-    kre, kim = np.empty((P, f.size)), np.empty((P, f.size))
-    solver = _k.solve_parallel if P >= 64 else _k.solve  # threads pay off only for large batches
+    s, jump, kre, kim = _amplitudes(f, A, direction, shape, _joint_terms(model, shape), m, mu, gamma)
     mu_re = np.ascontiguousarray(mu.real)
-    mu_im = np.zeros_like(mu_re) if rigid else np.ascontiguousarray(mu.imag)
-    solver(w, mu_re, mu_im, np.ascontiguousarray(np.broadcast_to(logB, (P, f.size))), s0,
-             order.astype(np.int64), k, c, KT, R, chi, phimax, S, J1, k3, c2, _NODES, _WEIGHTS, TOL, s, jump,
-             kre, kim)
     q = np.exp(s)
     gain = _field(model.sensor_gain, shape)
     tau = _field(model.sensor_delay_s, shape)

@@ -51,6 +51,7 @@ neglected, as is the can's own transient where the fixture's mode lies inside th
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Literal
 
 import numpy as np
@@ -58,7 +59,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _envelope_kernel as _k
 from .amplitude import G
-from .envelope import _NODES, _WEIGHTS, _batch_shape, _field, _joint_terms, _structure_terms, steady_state
+from .envelope import _NODES, _WEIGHTS, _amplitudes, _batch_shape, _field, _joint_terms
 from .structure import MinistackModel
 
 __all__ = ["SweepDrive", "quasi_steady", "swept_transmissibility", "sweep_eta", "ETA_MIN", "SPAN", "CAP"]
@@ -91,13 +92,14 @@ class SweepDrive:
             raise ValueError("SweepDrive: t_s must increase, base_g be positive and window_s positive, got "
                              f"window_s {self.window_s!r}.")
 
+    @cached_property
     def rates(self) -> tuple[NDArray, NDArray]:
         """Drive-frequency rate df/dt (Hz/s) and base-amplitude rate dlog A/dt (1/s) at the frames."""
         return np.gradient(self.f_hz, self.t_s), np.gradient(np.log(self.base_g), self.t_s)
 
     def at(self, t: ArrayLike) -> tuple[NDArray, ...]:
         """f (Hz), base (g), df/dt (Hz/s), dlog A/dt (1/s) interpolated at times t (s)."""
-        r, dl = self.rates()
+        r, dl = self.rates
         return tuple(np.interp(t, self.t_s, v) for v in (self.f_hz, self.base_g, r, dl))
 
 
@@ -107,19 +109,28 @@ def sweep_eta(rate_hz_per_s: float, f_res_hz: float, zeta: float) -> float:
 
 
 def _derivs(model: MinistackModel, w: NDArray, shape) -> tuple[NDArray, ...]:
-    """mu, mu', mu'' and F = -gamma m, F', F'' at w (rad/s), each (P, N); derivatives in omega."""
+    """mu, mu', mu'' and F = -gamma m, F', F'' at w (rad/s), each (P, N); derivatives in omega.
+
+    Fixture (`envelope._structure_terms`): mu = m omega^2 + m^2 omega^4 / a11, gamma = kc / a11 with
+    kc = k_can + i omega c_can and a11 = kc - omega^2 (m_can + m), differentiated in closed form.
+    """
     m = _field(model.m, shape)[:, None]
+    z = np.zeros((shape[0], w.size), complex)
     if model.fixture is None:
-        z = np.zeros((shape[0], w.size))
-        return m * w**2 + 0j, 2 * m * w + 0j, 2 * m + z + 0j, -m + z + 0j, z + 0j, z + 0j
-
-    def terms(ww):
-        mu, gamma = _structure_terms(model, ww, shape)
-        return mu, -gamma * m
-
-    d = 1e-4 * w  # central differences: the condensed can is a smooth rational function of omega
-    (mu, F), (mp, Fp), (mm, Fm) = terms(w), terms(w + d), terms(w - d)
-    return mu, (mp - mm) / (2 * d), (mp - 2 * mu + mm) / d**2, F, (Fp - Fm) / (2 * d), (Fp - 2 * F + Fm) / d**2
+        return m * w**2 + z, 2 * m * w + z, 2 * m + z, -m + z, z, z
+    fx = model.fixture
+    mc = _field(fx.m_can, shape)[:, None]
+    kc0 = mc * (2 * np.pi * _field(fx.f_can, shape)[:, None]) ** 2
+    cc = 2.0 * _field(fx.zeta_can, shape)[:, None] * np.sqrt(kc0 * mc)
+    kc, kc1 = kc0 + 1j * w * cc, 1j * cc + z
+    a, a1, a2 = kc - w**2 * (mc + m), kc1 - 2 * w * (mc + m), -2 * (mc + m) + z
+    mu = m * w**2 + m**2 * w**4 / a
+    mu1 = 2 * m * w + m**2 * (4 * w**3 / a - w**4 * a1 / a**2)
+    mu2 = 2 * m + m**2 * (12 * w**2 / a - 8 * w**3 * a1 / a**2 - w**4 * a2 / a**2 + 2 * w**4 * a1**2 / a**3)
+    F = -m * kc / a
+    F1 = -m * (kc1 / a - kc * a1 / a**2)
+    F2 = -m * (-2 * kc1 * a1 / a**2 - kc * a2 / a**2 + 2 * kc * a1**2 / a**3)
+    return mu, mu1, mu2, F, F1, F2
 
 
 def _linearised(D: NDArray, Ks: NDArray, Z0: NDArray, rhs: NDArray) -> NDArray:
@@ -135,22 +146,26 @@ def _linearised(D: NDArray, Ks: NDArray, Z0: NDArray, rhs: NDArray) -> NDArray:
 def _quasi_steady(model: MinistackModel, f: NDArray, base_g: NDArray, rate: NDArray, dlog: NDArray,
                   direction: str) -> tuple[NDArray, NDArray, NDArray]:
     """(R, Z, A): slug acceleration envelope (in/s^2), joint envelope Z_0 + Z_1 (in), base (in/s^2), (P, N)."""
-    ss = steady_state(model, f, base_g, direction=direction)
     shape, _ = _batch_shape(model, f.shape)
     P, N = shape
-    Z0 = ss.relative.reshape(P, N)
-    q = np.abs(Z0)
     w = 2 * np.pi * f
-    slopes = np.empty((5, P, N))
-    _k.stiffness_slopes(np.ascontiguousarray(q), w, *_joint_terms(model, shape), _NODES, _WEIGHTS, slopes)
-    Kz, Ks, dKw = slopes[0] + 1j * slopes[1], slopes[2] + 1j * slopes[3], 1j * slopes[4]
-    mu, mu1, mu2, F, F1, F2 = _derivs(model, w, shape)
     A = np.broadcast_to(np.asarray(base_g, float), f.shape) * G
+    m = _field(model.m, shape)
+    joint = _joint_terms(model, shape)
+    mu, mu1, mu2, F, F1, F2 = _derivs(model, w, shape)
+    gamma = None if model.fixture is None else -F / m[:, None]
+    s, _, kre, kim = _amplitudes(f, A, direction, shape, joint, m, mu if gamma is not None else mu.real, gamma)
+    q = np.exp(s)
+    Kz = kre + 1j * kim
+    D = Kz - mu
+    Z0 = F * A / D
+    slopes = np.empty((5, P, N))
+    _k.stiffness_slopes(q, w, *joint, _NODES, _WEIGHTS, slopes)
+    Ks, dKw = slopes[2] + 1j * slopes[3], 1j * slopes[4]
+    C = slopes[4]  # dIm K_z / domega: the dashpots turn the envelope's rate into force
+    C1 = (C - joint[1][:, None]) / w  # its own omega-slope (the quadratic damper's)
     alpha = 2 * np.pi * np.broadcast_to(np.asarray(rate, float), f.shape)
     dl = np.broadcast_to(np.asarray(dlog, float), f.shape)
-    D = Kz - mu
-    C = slopes[4]  # dIm K_z / domega: the dashpots turn the envelope's rate into force
-    C1 = (C - _joint_terms(model, shape)[1][:, None]) / w  # its own omega-slope (the quadratic damper's)
     with np.errstate(all="ignore"):
         dZ0 = (alpha * _linearised(D, Ks, Z0, F1 * A - (dKw - mu1) * Z0)
                + dl * _linearised(D, Ks, Z0, F * A))
@@ -161,7 +176,7 @@ def _quasi_steady(model: MinistackModel, f: NDArray, base_g: NDArray, rate: NDAr
         Z1 = np.where(big, Z1 * CAP * q / np.abs(Z1), Z1)
         Z1 = np.where(np.isfinite(Z1), Z1, 0.0)
     force = Kz * (Z0 + Z1) + Z0 * Ks * np.real(np.conj(Z0) * Z1) / q**2 + C * dZ0 + 0.5 * alpha * C1 * Z0
-    return -force / _field(model.m, shape)[:, None], Z0 + Z1, np.broadcast_to(A, (P, N))
+    return -force / m[:, None], Z0 + Z1, np.broadcast_to(A, (P, N))
 
 
 def _sensor(model: MinistackModel, f: NDArray, shape) -> NDArray:
@@ -231,7 +246,7 @@ def swept_transmissibility(model: MinistackModel, drive: SweepDrive, t_s: ArrayL
     """
     t_out = np.atleast_1d(np.asarray(t_s, dtype=float))
     f_o, b_o, r_o, dl_o = drive.at(t_out)
-    rate = float(np.median(drive.rates()[0]))
+    rate = float(np.median(drive.rates[0]))
     direction = "up" if rate >= 0 else "down"
     shape = (1, t_out.size)
     R, _, A = _quasi_steady(model, f_o, b_o, r_o, dl_o, direction)
@@ -257,7 +272,7 @@ def swept_transmissibility(model: MinistackModel, drive: SweepDrive, t_s: ArrayL
 def _integrated(model: MinistackModel, drive: SweepDrive, t_a: float, t_b: float, ka: int, t_out: NDArray,
                 direction: str, gamma: float, x_max: float) -> NDArray[np.complex128]:
     """<R> / <A> over the Hann window of each frame t_out, the slow flow integrated over [t_a, t_b]."""
-    r_d, dl_d = drive.rates()
+    r_d, dl_d = drive.rates
     _, Z, _ = _quasi_steady(model, drive.f_hz[:ka + 1], drive.base_g[:ka + 1], r_d[:ka + 1], dl_d[:ka + 1],
                             direction)
     h = STEP / ((x_max + 1.0) * gamma)
