@@ -15,9 +15,10 @@ import pytest
 
 from jointcal.calibrate import CalibrateSettings, run_calibration
 from jointcal.calibrate.space import PARAMS
-from jointcal.discrepancy import EFFECTS, DiscrepancySettings, decide, diagnose, score_candidates
+from jointcal.discrepancy import EFFECTS, DiscrepancySettings, decide, diagnose, diagnosis_markdown, score_candidates
 from jointcal.discrepancy.data import RunEnvelope
 from jointcal.discrepancy.fit import candidate, envelope_E, model_at, predict
+from jointcal.discrepancy.select import NONE_E, Scored, confirm, needs_pairs, pair_names
 from jointcal.discrepancy.stage import valley_starts
 from jointcal.models import G
 
@@ -135,6 +136,92 @@ def test_an_even_harmonic_no_library_effect_leaves_caps_the_decision():
     assert decide(partly, why)[:2] == ("unexplained", "low")
     assert decide(fully)[:2] == ("sensor_gain", "high")
     assert decide(fully, why)[:2] == ("sensor_gain", "medium")
+
+
+def _scored(name, score):
+    fit = type("F", (), {"E": score, "theta": np.zeros(9)})()
+    return Scored(name, fit, score)
+
+
+def test_two_effects_are_named_only_when_the_pair_closes_and_no_single_does():
+    """Forward selection: pairs are tried when the best single leaves the held-out score above the
+    'none' threshold; the pair is named when it closes the gap decisively (beats the best single and
+    the next pair by the margin), else the single rule stands."""
+    singles = [_scored("baseline", 12.0), _scored("fixture_flexibility", 6.0), _scored("quadratic_damping", 7.0),
+               _scored("sensor_gain", 11.0)]
+    assert needs_pairs(singles)
+    assert decide(singles)[:2] == ("unexplained", "low")  # 6 vs 7: not decisive
+    names = pair_names(singles, ["fixture_flexibility", "quadratic_damping", "sensor_gain"])
+    # the runner-up is not beaten decisively, so it is a base too; each pair once
+    assert names == ["fixture_flexibility+quadratic_damping", "fixture_flexibility+sensor_gain",
+                     "quadratic_damping+sensor_gain"]
+    pairs = [_scored(names[0], 1.4), _scored(names[1], 5.5), _scored(names[2], 6.5)]
+    assert decide(singles + pairs)[:2] == ("fixture_flexibility+quadratic_damping", "high")
+    close = [_scored(names[0], 1.4), _scored(names[1], 1.8), _scored(names[2], 6.5)]
+    assert decide(singles + close)[:2] == ("unexplained", "low")  # two pairs close alike: neither is named
+    one = [_scored("baseline", 12.0), _scored("sensor_gain", 1.3), _scored("channel_delay", 9.0)]
+    assert not needs_pairs(one) and decide(one)[:2] == ("sensor_gain", "high")
+    even = "the response's 2nd harmonic dominates"
+    assert decide(singles + pairs, even)[:2] == ("fixture_flexibility+quadratic_damping", "medium")
+
+
+def test_the_fast_models_floor_is_taken_out_of_the_baseline_before_none():
+    """A baseline at 1.9 is 'unexplained' on a perfect fast model, 'none' when 1.2 of it is the fast
+    model's own error (sqrt(1.9^2 - 1.2^2) = 1.47 <= 1.5); a floor above the scatter caps confidence."""
+    sc = [_scored("baseline", 1.9), _scored("sensor_gain", 1.85), _scored("channel_delay", 1.88)]
+    assert decide(sc)[0] == "unexplained"
+    assert decide(sc, floor=1.2)[0] == "none"
+    strong = [_scored("baseline", 20.0), _scored("sensor_gain", 1.5), _scored("channel_delay", 15.0)]
+    assert decide(strong)[1] == "high" and decide(strong, floor=1.2)[1] == "medium"
+
+
+def test_the_time_simulation_has_the_last_word():
+    assert confirm("none", "high", 0.37, 0.2) == ("none", "high", None)
+    assert confirm("none", "high", 0.4, 3.0) == ("none", "high", None)  # before within the scatter
+    assert confirm("none", "high", 2.5, 2.2) == ("unexplained", "low", "none_contradicted")
+    assert confirm("sensor_gain", "high", 6.0, 1.1) == ("sensor_gain", "high", None)
+    assert confirm("sensor_gain", "high", 6.0, 6.5) == ("sensor_gain", "low", "name_not_confirmed")
+
+
+def _diagnosis(effect, E0, E1, S_b, floor, candidates, **kw):
+    cands = []
+    for name, score in candidates:
+        eff = tuple(name.split("+"))
+        cands.append({"name": name, "effects": list(eff), "held_out_score": score, "fingerprints_for": [],
+                      "fingerprints_against": [f"not seen: {name} fingerprint"],
+                      "effect_parameters": {p.name: {"value": p.start or 1.0, "unit": p.unit, "interval_90": [0.9, 1.1]}
+                                            for e in eff for p in EFFECTS[e].params}})
+    named = [] if effect in ("none", "unexplained") else effect.split("+")
+    rec = next((c["effect_parameters"] for c in cands if c["name"] == effect), {})
+    return {"assembly": "a", "effect": effect, "effects": named, "confidence": kw.get("confidence", "high"),
+            "metric_before": E0, "metric_after": E1, "baseline": {"held_out_score": S_b},
+            "fast_model_floor": {"E": floor, "per_level": {"1": floor}}, "candidates": cands,
+            "outside_library": kw.get("outside"), "time_domain_check": kw.get("note"),
+            "recalibrated": {"effect_parameters": rec}}
+
+
+def test_the_words_never_contradict_the_verdict():
+    none = diagnosis_markdown(_diagnosis("none", 0.37, 0.2, 1.1, 0.14, [("sensor_gain", 1.1)]))
+    assert "No missing effect" in none and "E = 0.37" in none and "misses" not in none
+    refit = diagnosis_markdown(_diagnosis("none", 2.4, 0.3, 1.1, 0.14, [("sensor_gain", 1.1)]))
+    assert "were off" in refit and "E = 0.30" in refit
+    # unexplained while the time domain is within the scatter: said to disagree, not "the model misses"
+    un = diagnosis_markdown(_diagnosis("unexplained", 0.37, 0.3, 1.9, 0.14,
+                                       [("sensor_gain", 1.8), ("sensor_gain+channel_delay", 1.7)],
+                                       outside="the response's 2nd harmonic is 7% of the fundamental"))
+    assert "disagree" in un and "misses" not in un
+    assert "`sensor_gain`" in un and "`sensor_gain+channel_delay`" in un  # everything tried
+    assert "E = 0.14" in un and "2nd harmonic is 7%" in un  # the floor and what points outside
+    contra = diagnosis_markdown(_diagnosis("unexplained", 2.5, 2.2, 1.2, 0.14, [("sensor_gain", 1.1)],
+                                           note="none_contradicted"))
+    assert "disagree" in contra and "within 1.20x" in contra
+    pair = diagnosis_markdown(_diagnosis("fixture_flexibility+quadratic_damping", 9.0, 1.2, 9.5, 0.14,
+                                         [("fixture_flexibility+quadratic_damping", 1.3), ("fixture_flexibility", 5.0)]))
+    assert "Two missing effects" in pair and "fixture below the joint" in pair and "velocity" in pair
+    assert "falls from 9.00 to 1.20" in pair
+    worse = diagnosis_markdown(_diagnosis("sensor_gain", 6.0, 6.5, 7.0, 0.14, [("sensor_gain", 1.9)],
+                                          confidence="low", note="name_not_confirmed"))
+    assert "does not fall" in worse and "does not confirm" in worse and "(confidence low)" in worse
 
 
 def test_bad_settings_are_one_sentence():
