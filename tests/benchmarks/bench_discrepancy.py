@@ -51,16 +51,10 @@ CASES = [
 ]
 
 
-def run_case(i, name, params, tmp: Path):
-    joint = JOINTS[i % 2]
-    spec = {"seed": 100 + i, "sample_rate_hz": (10000.0, 25600.0)[i % 2],
-            "sweep": {"f_start_hz": 1500.0, "f_stop_hz": 2900.0, "rate_hz_per_s": (150.0, 500.0)[(i // 2) % 2]},
-            "series": [{"level_g": 1.0, "directions": ["up", "down"], "repeats": 2},
-                       {"level_g": 3.0, "directions": ["up", "down"], "repeats": 1},
-                       {"level_g": 10.0, "directions": ["up", "down"], "repeats": 1}],
-            "assemblies": {"a": joint},
-            "effect": {"name": name, "params": {k: v for k, v in params.items() if k != "also"},
-                       **({"also": params["also"]} if "also" in params else {})}}
+def diagnose_campaign(spec: dict, tmp: Path, assembly: str = "a", settings: DiscrepancySettings = DiscrepancySettings()):
+    """Generate a virtual-lab campaign, measure it, calibrate `assembly` (GA) and diagnose it.
+
+    Returns (diagnosis, modal table, ga_best, stage wall time in s)."""
     generate(spec, tmp / "c", tmp / "truth.json")
     man = read_manifest(tmp / "c" / "manifest.csv")
     rows, envs, records, props = [], {}, [], []
@@ -72,18 +66,33 @@ def run_case(i, name, params, tmp: Path):
     table = pd.DataFrame(props)
     write_csv_atomic(table, tmp / "modal.csv")
     write_csv_atomic(scatter(table), tmp / "scatter.csv")
-    run_calibration(tmp / "modal.csv", "a", tmp / "cal", CalibrateSettings())
+    run_calibration(tmp / "modal.csv", assembly, tmp / "cal", CalibrateSettings())
     best = json.loads((tmp / "cal" / "ga_best.json").read_text())
     starts = valley_starts(pd.read_csv(tmp / "cal" / "ga_history.csv"), best)
+    mine = [i for i, r in enumerate(rows) if r["assembly"] == assembly]
     t0 = time.perf_counter()
-    d = diagnose("a", envs, table, best, None, records, rows, space=CalibrateSettings().space,
-                 settings=DiscrepancySettings(), joint_starts=starts)["diagnosis"]
-    wall = time.perf_counter() - t0
+    d = diagnose(assembly, envs, table, best, None, [records[i] for i in mine], [rows[i] for i in mine],
+                 space=CalibrateSettings().space, settings=settings, joint_starts=starts)["diagnosis"]
+    return d, table[table["assembly"] == assembly], best, time.perf_counter() - t0
+
+
+def run_case(i, name, params, tmp: Path):
+    joint = JOINTS[i % 2]
+    spec = {"seed": 100 + i, "sample_rate_hz": (10000.0, 25600.0)[i % 2],
+            "sweep": {"f_start_hz": 1500.0, "f_stop_hz": 2900.0, "rate_hz_per_s": (150.0, 500.0)[(i // 2) % 2]},
+            "series": [{"level_g": 1.0, "directions": ["up", "down"], "repeats": 2},
+                       {"level_g": 3.0, "directions": ["up", "down"], "repeats": 1},
+                       {"level_g": 10.0, "directions": ["up", "down"], "repeats": 1}],
+            "assemblies": {"a": joint},
+            "effect": {"name": name, "params": {k: v for k, v in params.items() if k != "also"},
+                       **({"also": params["also"]} if "also" in params else {})}}
+    d, table, best, wall = diagnose_campaign(spec, tmp)
     after = d["recalibrated"]["joint_parameters"]
     keys = [p for p in PARAMS if p != "beta"]
     e0 = np.mean([abs(np.log(best[p] / joint[p])) for p in keys])
     e1 = np.mean([abs(np.log(after[p]["value"] / joint[p])) for p in keys])
     per = ", ".join(f"{c['name']} {c['seconds']:.0f}s" for c in d["candidates"])
+    floor = d["fast_model_floor"]["E"]
     each = " ".join(f"{p} {abs(np.log(best[p] / joint[p])):.2f}->{abs(np.log(after[p]['value'] / joint[p])):.2f}"
                     for p in keys)
     # what the envelopes identify: the joint's frequency and damping curves over the measured amplitudes
@@ -99,6 +108,8 @@ def run_case(i, name, params, tmp: Path):
                   for lab, v in (("k+KT", lambda p: p["k"] + p["KT"]),))
     curves = (f"curves vs truth: f {errs[0][0]:.3f}%->{errs[1][0]:.3f}%, zeta {errs[0][1]:.1f}%->{errs[1][1]:.1f}%, {kk}")
     return (f"{name:20s} {json.dumps(params):40s} -> {d['effect']:20s} {d['confidence']:6s} "
+            f"floor {floor if floor is None else round(floor, 2)} baseline S {d['baseline']['held_out_score']:.2f} "
+            f"pairs tried {len(d['pairs_tried'])} "
             f"E {d['metric_before']:6.2f} -> {d['metric_after']:5.2f} ({(d['metric_after'] / d['metric_before'] - 1) * 100:+4.0f}%) "
             f"joint |log err| {e0:.2f} -> {e1:.2f} ({each}); {curves}; stage {wall:.0f} s ({per})")
 
