@@ -57,7 +57,7 @@ def test_effect_parameters_map_to_the_unit_cube_and_back():
 
 
 def test_a_new_library_effect_grows_the_space_and_is_fitted_without_other_changes(monkeypatch):
-    """Issue 9: the parameter space grows by an effect's parameters with no code change elsewhere.
+    """The parameter space grows by an effect's parameters with no code change elsewhere.
     A new entry (a base-channel gain error, the response read against a base that reads b high:
     T_read = T / b) is registered in the library only; the fit's space becomes the six joint columns
     plus b with its bounds and scaling, and the hidden b = 0.9 is recovered and named."""

@@ -1,4 +1,4 @@
-"""Acceptance and benchmark of the discrepancy stage on hidden-effect campaigns (issue 9).
+"""Acceptance and benchmark of the discrepancy stage on hidden-effect campaigns.
 
 Each case: a campaign from the virtual lab (`jointcal.synth.generate`: exact-Iwan time
 simulation, DAQ chain, one assembly, 1 g x2 up/down, 3 g and 10 g up/down) with joint
@@ -13,9 +13,9 @@ time and the per-candidate times.
 
 Strengths: cubic k3 = 2e11 lbf/in^3 moves the 10 g resonance by ~0.6% (3/4 k3 q^2 / (2 k) with
 q ~ 3e-4 in, k ~ 1.2e6 lbf/in); quadratic c2 = 0.4 lbf s^2/in^2 adds 4 c2 q / (3 pi m) ~ 0.007 to
-the 10 g damping (~20%); the rest span the issue's ranges. The last cases hide what the
-library does not have (two effects at once; a unilateral contact spring): a wrong library
-name given with high confidence fails them.
+the 10 g damping (~20%); the rest span the ranges the library is meant for. Then two
+effects at once (forward selection should name both) and what the library does not have
+(a unilateral contact spring): a wrong library name given with high confidence fails them.
 """
 import argparse
 import json
@@ -43,7 +43,7 @@ CASES = [
     ("fixture_flexibility", {"f_can_hz": 3000.0}), ("fixture_flexibility", {"f_can_hz": 8000.0}),
     ("joint_settling", {"Fs_drift": 0.05, "KT_drift": 0.05}), ("joint_settling", {"Fs_drift": 0.15, "KT_drift": 0.1}),
     ("cubic_stiffening", {"k3": 2e11}), ("quadratic_damping", {"c2": 0.4}),
-    # two effects at once: a name among the two is right, a third name or high confidence on one is not
+    # two effects at once: both named is right; a third name, or high confidence on one alone, is not
     ("sensor_gain", {"gain": 1.1, "also": {"name": "channel_delay", "params": {"tau_s": 4e-5}}}),
     ("fixture_flexibility", {"f_can_hz": 6000.0, "also": {"name": "quadratic_damping", "params": {"c2": 0.4}}}),
     # outside the library: a unilateral contact beyond a gap (engages above ~3 g) and from rest

@@ -2,10 +2,12 @@
 
 Each effect is a model augmentation with one to three parameters (physical bounds and
 units) living in `MinistackModel`, so the steady-state envelope model
-(`jointcal.models.steady_state`), harmonic balance and the time simulation all see it.
+(`jointcal.models.swept`), harmonic balance and the time simulation all see it.
 An effect is one entry of `EFFECTS`: its parameters and a function
 (baseline model, values, manifest row) -> augmented model. Adding an effect is adding
 an entry here (and, if the structure lacks the physics, a field of `MinistackModel`).
+Effects present together are named by joining them with `JOIN` ("a+b") and applied in
+turn (`apply_effect`); their parameter names are distinct.
 
 =====================  =============================================  =====================================
 effect                 parameters                                     what it is
