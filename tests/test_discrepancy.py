@@ -165,6 +165,27 @@ def test_two_effects_are_named_only_when_the_pair_closes_and_no_single_does():
     assert decide(singles + pairs, even)[:2] == ("fixture_flexibility+quadratic_damping", "medium")
 
 
+def test_gain_and_delay_hidden_together_are_named_both():
+    """Envelopes of the true model with the response channel 10% high AND 40 us late: neither effect
+    alone predicts the held-out levels (magnitude or phase stays off), the pair does; both values recovered."""
+    runs = _runs("sensor_gain+channel_delay", [1.1, 4e-5], seed=5)
+    start = TRUTH * np.array([1.1, 0.95, 1.0, 1.0, 1.05, 1.2])
+    singles = score_candidates([candidate(n, SPACE, M) for n in ("baseline", "sensor_gain", "channel_delay")],
+                               runs, start, max_nfev=25)
+    assert needs_pairs(singles)
+    names = pair_names(singles, ["sensor_gain", "channel_delay"])
+    fits = {s.name: s.fit.theta for s in singles}
+    base = next(s for s in singles if s.name == "baseline")
+    pairs = score_candidates([candidate(n, SPACE, M) for n in names], runs, start, max_nfev=25, baseline=base,
+                             starts={n: fits[n.split("+")[0]] for n in names})
+    name, conf, ranked = decide(singles + pairs)
+    print("\n" + ", ".join(f"{s.name} {s.score:.2f}" for s in singles + pairs) + f" -> {name} ({conf})")
+    assert set(name.split("+")) == {"sensor_gain", "channel_delay"} and conf == "high"
+    c = candidate(name, SPACE, M)
+    got = dict(zip(c.names[6:], ranked[0].fit.theta[6:]))
+    assert abs(got["gain"] / 1.1 - 1) < 0.01 and abs(got["tau_s"] / 4e-5 - 1) < 0.05
+
+
 def test_the_fast_models_floor_is_taken_out_of_the_baseline_before_none():
     """A baseline at 1.9 is 'unexplained' on a perfect fast model, 'none' when 1.2 of it is the fast
     model's own error (sqrt(1.9^2 - 1.2^2) = 1.47 <= 1.5); a floor above the scatter caps confidence."""
