@@ -140,6 +140,10 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     """
     say = log or (lambda s: None)
     t_start = time.perf_counter()
+    clock = {}
+
+    def lap(step: str) -> None:  # seconds per step of the stage, for diagnosis.json
+        clock[step] = time.perf_counter() - t_start - sum(clock.values())
     m = float(best["m"])
     theta0 = np.array([best[p] for p in PARAMS], dtype=float)
     if scale is None or frames_before is None:  # as the validation stage does: the calibrated model in time
@@ -148,6 +152,7 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
         scale = v_before.scale.to_dict(orient="records") if scale is None else scale
         frames_before = v_before.frames
         metric_before = float(v_before.error["E"]) if metric_before is None else metric_before
+    lap("validate_before")
     sdb, sdeg = scale_arrays(scale)
     mrows = modal[modal["assembly"] == assembly].set_index("run_id")
     zeta_min = float((envelopes_kw or {}).get("zeta_min", 0.01))
@@ -169,9 +174,11 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     F = floor["E"] if floor["E"] is not None else 0.0
     say(f"{assembly}: the fast model's floor (its envelope of the calibrated model against the time simulation) "
         f"E = {F:.2f}" + ("" if floor["E"] is not None else " (no validation frames to compare: taken as 0)"))
+    lap("floor")
     cands = [c0] + [candidate(n, space, m) for n in settings.candidates]
     scored = score_candidates(cands, runs, theta0, max_nfev=settings.max_nfev, log=say)
     base = next(s for s in scored if s.name == "baseline")
+    lap("singles")
     pairs_tried = []
     if needs_pairs(scored, F):
         names = pair_names(scored, settings.candidates)
@@ -181,6 +188,7 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
         scored += score_candidates(pc, runs, theta0, max_nfev=settings.max_nfev, log=say, baseline=base,
                                    starts={n: fits[effects_of(n)[0]] for n in names})
         pairs_tried = names
+    lap("pairs")
     # localise: residuals of the baseline refit, fingerprints
     runs_b = with_transient(c0, base.fit.theta, runs)
     res = residual_map(c0, base.fit.theta, runs_b)
@@ -209,6 +217,7 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
         fits.append(alt)
     rec = recalibrate(cf, runs, fits, seed=settings.seed, generations=settings.ga_generations,
                       steps=settings.posterior_steps, max_nfev=2 * settings.max_nfev)
+    lap("recalibrate")
     say(f"{assembly}: {final.name} recalibrated: GA best E {rec.ga_best_E:.2f} ({rec.ga_generations} generations), "
         f"polished E {rec.fit.E:.2f}; emcee {rec.steps} steps, tau {rec.tau_max:.0f}")
     final = type(final)(final.name, rec.fit, final.score, final.held_out, final.seconds)
@@ -221,6 +230,7 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
                                  envelopes_kw=envelopes_kw, modal_kw=modal_kw, executor=executor)
         metric_before = float(v_before.error["E"])
     metric_after = float(v_after.error["E"])
+    lap("validate_after")
     effect, confidence, time_note = confirm(effect, confidence, float(metric_before), metric_after)
     joint_after = {p: {"value": float(final.fit.theta[i]), "interval_90": rec.interval(i)}
                    for i, p in enumerate(PARAMS)}
@@ -245,6 +255,6 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
                                     + "; intervals are the 5-95% posterior quantiles"),
                          "posterior_converged": rec.converged},
         "calibration_joint_parameters": dict(zip(PARAMS, map(float, theta0))),
-        "words_after": v_after.words, "seconds": time.perf_counter() - t_start,
+        "words_after": v_after.words, "seconds": time.perf_counter() - t_start, "seconds_per_step": clock,
     }
     return {"diagnosis": diagnosis, "residuals": res, "validation_after": v_after}
