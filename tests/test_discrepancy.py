@@ -196,6 +196,15 @@ def test_the_fast_models_floor_is_taken_out_of_the_baseline_before_none():
     assert decide(strong)[1] == "high" and decide(strong, floor=1.2)[1] == "medium"
 
 
+def test_within_the_scatter_only_a_drift_with_the_sequence_is_named():
+    """A baseline within the scatter is 'none' even if a candidate halves it, unless that candidate drifts
+    with the run sequence (its drift inflates the repeat scatter the baseline is judged by)."""
+    quad = [_scored("baseline", 0.63), _scored("quadratic_damping", 0.28), _scored("sensor_gain", 0.6)]
+    assert decide(quad)[0] == "none"
+    settle = [_scored("baseline", 1.2), _scored("joint_settling", 0.4), _scored("sensor_gain", 1.1)]
+    assert decide(settle)[:2] == ("joint_settling", "medium")
+
+
 def test_the_time_simulation_has_the_last_word():
     assert confirm("none", "high", 0.37, 0.2) == ("none", "high", None)
     assert confirm("none", "high", 0.4, 3.0) == ("none", "high", None)  # before within the scatter

@@ -33,7 +33,7 @@ import numpy as np
 
 from .data import RunEnvelope
 from .fit import Candidate, Fit, envelope_E, fit_candidate, with_transient
-from .library import JOIN, effects_of
+from .library import EFFECTS, JOIN, effects_of
 
 __all__ = ["NONE_E", "CLOSE_FRACTION", "MARGIN", "PENALTY_PER_PARAM", "WITHIN_SCATTER", "FLOOR_HIGH", "Scored",
            "score_candidates", "needs_pairs", "pair_names", "decide", "confirm", "RULE"]
@@ -46,8 +46,9 @@ WITHIN_SCATTER = 0.5
 FLOOR_HIGH = 1.0  # a fast-model floor above this (the repeat scatter) caps every confidence at medium
 
 RULE = (f"Scores S are held-out fast-model E (1 = the repeat scatter), S_b the baseline's, F the fast model's "
-        f"floor. 'none' if sqrt(S_b^2 - F^2) <= {NONE_E} (unless the best single effect scores <= "
-        f"{WITHIN_SCATTER} x S_b and <= {MARGIN} x the runner-up: named, medium). Otherwise a single effect is "
+        f"floor. 'none' if sqrt(S_b^2 - F^2) <= {NONE_E} (unless the best single effect changes with the run "
+        f"sequence, whose drift inflates the repeat scatter, and scores <= {WITHIN_SCATTER} x S_b and <= {MARGIN} x "
+        "the runner-up: named, medium). Otherwise a single effect is "
         f"named if it closes >= {CLOSE_FRACTION:.0%} of the baseline's excess over 1 and scores <= {MARGIN} x "
         f"the runner-up (high when its score <= 2). If the best single scores above {NONE_E}, effects are added "
         f"to it one at a time (forward selection); a pair is named instead when it closes >= "
@@ -205,13 +206,19 @@ def decide(scored: Sequence[Scored], outside: str | None = None, *, floor: float
     return name, conf, ranked
 
 
+def _drifts(name: str) -> bool:
+    """Whether the model changes with the run sequence: its drift inflates the repeat scatter it is judged by."""
+    return any(EFFECTS[e].sequence_dependent for e in effects_of(name))
+
+
 def _closes(sb: float, s: float) -> bool:
     return sb - s >= CLOSE_FRACTION * (sb - 1.0)
 
 
 def _rule(sb, s1, s2, singles, pairs, outside, floor) -> tuple[str, str]:
     if _above_floor(sb, floor) <= NONE_E:
-        if singles and s1 <= WITHIN_SCATTER * sb and s1 <= MARGIN * s2 and not outside:
+        if (singles and _drifts(singles[0].name) and s1 <= WITHIN_SCATTER * sb and s1 <= MARGIN * s2
+                and not outside):
             return singles[0].name, "medium"
         return "none", "high" if (not singles or s1 > 0.8 * sb) else "medium"
     if pairs:
