@@ -8,7 +8,8 @@ revalidates in the time domain).
 
 ``--none``: no hidden effect, sample rates 10-25.6 kHz x sweep rates 100-600 Hz/s (the
 corners and the example's 12.8 kHz at 400 Hz/s with the two Table 3.2 assemblies and
-their 1-2-5-10 g series), three seeds each. Pass: 'none' every time. The table gives,
+their 1-2-5-10 g series), three seeds each, and beyond that grid a lightly damped joint
+swept at 800 Hz/s (eta up to about 1). Pass: 'none' every time. The table gives,
 per campaign, the sweep's eta range, the fast model's floor (its envelope of the
 calibrated model against the time simulation, E units), the calibrated model's
 time-domain E, the baseline's held-out score, the verdict and the stage's time.
@@ -35,6 +36,8 @@ SERIES = [{"level_g": 1.0, "directions": ["up", "down"], "repeats": 2},
           {"level_g": 10.0, "directions": ["up", "down"], "repeats": 1}]
 SEEDS = (1, 2, 3)
 CELLS = [(10000.0, 100.0), (10000.0, 600.0), (25600.0, 100.0), (25600.0, 600.0), (12800.0, 400.0)]
+LIGHT = {"Fs": 1500.0, "KT": 1.0e6, "chi": -0.7, "beta": 0.004, "k": 7.0e5, "zeta_v": 0.0006}  # 1.1% at 1 g
+LIGHT_RATE = 800.0  # with LIGHT: eta up to about 1
 PAIRS = [
     ({"name": "fixture_flexibility", "params": {"f_can_hz": 6000.0}},
      {"name": "quadratic_damping", "params": {"c2": 0.4}}),
@@ -55,6 +58,11 @@ def none_cases():
                 spec.update(series=SERIES, assemblies={"a": JOINTS[seed % 2]})
             for asm in (("first", "reassembly") if example else ("a",)):
                 out.append((f"{fs / 1000:g} kHz {rate:g} Hz/s seed {seed} {asm}", spec, asm, None))
+    for seed in SEEDS:  # beyond the grid: a lightly damped joint swept fast, eta up to about 1
+        spec = {"seed": seed, "sample_rate_hz": 10000.0,
+                "sweep": {"rate_hz_per_s": LIGHT_RATE, "f_start_hz": 1500.0, "f_stop_hz": 2900.0},
+                "series": SERIES, "assemblies": {"a": LIGHT}}
+        out.append((f"10 kHz {LIGHT_RATE:g} Hz/s light joint seed {seed} a", spec, "a", None))
     return out
 
 
