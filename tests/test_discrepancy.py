@@ -203,6 +203,12 @@ def test_within_the_scatter_only_a_drift_with_the_sequence_is_named():
     assert decide(quad)[0] == "none"
     settle = [_scored("baseline", 1.2), _scored("joint_settling", 0.4), _scored("sensor_gain", 1.1)]
     assert decide(settle)[:2] == ("joint_settling", "medium")
+    # the drift inflates the scatter: forward selection goes on from it, and a decisive pair is named
+    assert needs_pairs(settle) and not needs_pairs(quad)
+    with_cubic = [_scored("joint_settling+cubic_stiffening", 0.2), _scored("joint_settling+sensor_gain", 0.38)]
+    assert decide(settle + with_cubic)[:2] == ("joint_settling+cubic_stiffening", "medium")
+    alike = [_scored("joint_settling+cubic_stiffening", 0.3), _scored("joint_settling+sensor_gain", 0.35)]
+    assert decide(settle + alike)[:2] == ("joint_settling", "medium")
 
 
 def test_the_time_simulation_has_the_last_word():

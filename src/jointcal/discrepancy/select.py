@@ -14,10 +14,12 @@ held-out runs penalise flexibility (an extra parameter that only absorbs the fit
 runs' noise predicts the unseen level no better), and a further complexity penalty of
 `PENALTY_PER_PARAM` (relative, per extra parameter) is applied to the score.
 
-Forward selection. When the best single effect leaves a held-out score above `NONE_E`
-(`needs_pairs`), each other effect is added to it (and to the runner-up, if the best does
-not beat it decisively): the pairs are fitted and scored the same way, on the same folds,
-with the penalty for all their parameters (`pair_names`).
+Forward selection. When the best single effect leaves a held-out score above `NONE_E`, or
+is a drift with the run sequence found within the scatter (the drift inflates the repeat
+scatter, so a second effect may hide in it) (`needs_pairs`), each other effect is added to
+it (and to the runner-up, if the best does not beat it decisively): the pairs are fitted
+and scored the same way, on the same folds, with the penalty for all their parameters
+(`pair_names`).
 
 The fast model's floor F (its own error against the time simulation of the calibrated model
 on the same runs and bins, `floor.fast_floor`) is taken out of the baseline's score before
@@ -48,7 +50,8 @@ FLOOR_HIGH = 1.0  # a fast-model floor above this (the repeat scatter) caps ever
 RULE = (f"Scores S are held-out fast-model E (1 = the repeat scatter), S_b the baseline's, F the fast model's "
         f"floor. 'none' if sqrt(S_b^2 - F^2) <= {NONE_E} (unless the best single effect changes with the run "
         f"sequence, whose drift inflates the repeat scatter, and scores <= {WITHIN_SCATTER} x S_b and <= {MARGIN} x "
-        "the runner-up: named, medium). Otherwise a single effect is "
+        "the runner-up: named, medium; forward selection then goes on from it, and a pair with it that scores "
+        f"<= {MARGIN} x it and x the next pair is named instead, medium). Otherwise a single effect is "
         f"named if it closes >= {CLOSE_FRACTION:.0%} of the baseline's excess over 1 and scores <= {MARGIN} x "
         f"the runner-up (high when its score <= 2). If the best single scores above {NONE_E}, effects are added "
         f"to it one at a time (forward selection); a pair is named instead when it closes >= "
@@ -160,11 +163,16 @@ def _ranked(scored: Sequence[Scored], pairs: bool) -> list[Scored]:
 
 
 def needs_pairs(scored: Sequence[Scored], floor: float = 0.0) -> bool:
-    """Whether forward selection goes on to pairs: the baseline misses, and no single effect brings
-    the held-out score down to `NONE_E`."""
+    """Whether forward selection goes on to pairs: the baseline misses and no single effect brings the
+    held-out score down to `NONE_E`; or the single named is a drift with the run sequence found within
+    the scatter (that scatter is then partly the drift's, and judged without it a second effect may show)."""
     base = next(s for s in scored if s.name == "baseline")
     singles = _ranked(scored, False)
-    return bool(singles) and _above_floor(base.score, floor) > NONE_E and singles[0].score > NONE_E
+    if not singles:
+        return False
+    if _above_floor(base.score, floor) > NONE_E:
+        return singles[0].score > NONE_E
+    return _within_scatter_drift(base.score, singles, None)
 
 
 def pair_names(scored: Sequence[Scored], library: Sequence[str]) -> list[str]:
@@ -215,16 +223,30 @@ def _closes(sb: float, s: float) -> bool:
     return sb - s >= CLOSE_FRACTION * (sb - 1.0)
 
 
+def _within_scatter_drift(sb: float, singles: Sequence[Scored], outside) -> bool:
+    """The within-scatter branch of the rule: the best single drifts with the sequence and halves the baseline."""
+    s1 = singles[0].score if singles else np.inf
+    s2 = singles[1].score if len(singles) > 1 else np.inf
+    return bool(singles) and _drifts(singles[0].name) and s1 <= WITHIN_SCATTER * sb and s1 <= MARGIN * s2 and not outside
+
+
+def _pair_wins(pairs: Sequence[Scored], s1: float) -> bool:
+    """The best pair beats the best single and the next pair by the margin."""
+    p1 = pairs[0].score
+    p2 = pairs[1].score if len(pairs) > 1 else np.inf
+    return p1 <= MARGIN * s1 and p1 <= MARGIN * p2
+
+
 def _rule(sb, s1, s2, singles, pairs, outside, floor) -> tuple[str, str]:
     if _above_floor(sb, floor) <= NONE_E:
-        if (singles and _drifts(singles[0].name) and s1 <= WITHIN_SCATTER * sb and s1 <= MARGIN * s2
-                and not outside):
+        if _within_scatter_drift(sb, singles, outside):
+            if pairs and _drifts(pairs[0].name) and _pair_wins(pairs, s1):
+                return pairs[0].name, "medium"
             return singles[0].name, "medium"
         return "none", "high" if (not singles or s1 > 0.8 * sb) else "medium"
     if pairs:
         p1 = pairs[0].score
-        p2 = pairs[1].score if len(pairs) > 1 else np.inf
-        if _closes(sb, p1) and p1 <= MARGIN * s1 and p1 <= MARGIN * p2 and not (outside and p1 > 2.0):
+        if _closes(sb, p1) and _pair_wins(pairs, s1) and not (outside and p1 > 2.0):
             return pairs[0].name, "high" if (p1 <= 2.0 and not outside) else "medium"
     if not singles:
         return "unexplained", "low"
