@@ -177,7 +177,7 @@ def test_gain_and_delay_hidden_together_are_named_both():
     fits = {s.name: s.fit.theta for s in singles}
     base = next(s for s in singles if s.name == "baseline")
     pairs = score_candidates([candidate(n, SPACE, M) for n in names], runs, start, max_nfev=25, baseline=base,
-                             starts={n: fits[n.split("+")[0]] for n in names})
+                             starts={n: [fits[n.split("+")[0]]] for n in names})
     name, conf, ranked = decide(singles + pairs)
     print("\n" + ", ".join(f"{s.name} {s.score:.2f}" for s in singles + pairs) + f" -> {name} ({conf})")
     assert set(name.split("+")) == {"sensor_gain", "channel_delay"} and conf == "high"

@@ -16,10 +16,12 @@ runs' noise predicts the unseen level no better), and a further complexity penal
 
 Forward selection. When the best single effect leaves a held-out score above `NONE_E`, or
 is a drift with the run sequence found within the scatter (the drift inflates the repeat
-scatter, so a second effect may hide in it) (`needs_pairs`), each other effect is added to
-it (and to the runner-up, if the best does not beat it decisively): the pairs are fitted
-and scored the same way, on the same folds, with the penalty for all their parameters
-(`pair_names`).
+scatter, so a second effect may hide in it) (`needs_pairs`), the best single (and the
+runner-up, if the best does not beat it decisively, `pair_bases`) is first refit from the
+calibration's other valleys too, with the effort a pair gets (a pair must not win by
+the optimiser's luck alone); if it still leaves the gap, each other effect is added to it:
+the pairs are fitted and scored the same way, on the same folds, with the penalty for all
+their parameters (`pair_names`).
 
 The fast model's floor F (its own error against the time simulation of the calibrated model
 on the same runs and bins, `floor.fast_floor`) is taken out of the baseline's score before
@@ -38,7 +40,7 @@ from .fit import Candidate, Fit, envelope_E, fit_candidate, with_transient
 from .library import EFFECTS, JOIN, effects_of
 
 __all__ = ["NONE_E", "CLOSE_FRACTION", "MARGIN", "PENALTY_PER_PARAM", "WITHIN_SCATTER", "FLOOR_HIGH", "Scored",
-           "score_candidates", "needs_pairs", "pair_names", "decide", "confirm", "RULE"]
+           "score_candidates", "needs_pairs", "pair_bases", "pair_names", "decide", "confirm", "RULE"]
 
 NONE_E = 1.5
 CLOSE_FRACTION = 0.6
@@ -120,13 +122,14 @@ def _rms(values) -> float:
 
 def score_candidates(cands: Sequence[Candidate], runs: Sequence[RunEnvelope], theta_base, *,
                      max_nfev: int = 40, log=None, baseline: Scored | None = None,
-                     starts: dict[str, np.ndarray] | None = None) -> list[Scored]:
+                     starts: dict[str, Sequence[np.ndarray]] | None = None) -> list[Scored]:
     """Fit every candidate on all runs, then score it on held-out folds (see the module notes).
 
     The baseline is scored first (added if `cands` lacks it and `baseline` is not given): the
     other scores refer to it. Each fit refreshes the runs' sweep transient at its optimum,
-    and the folds keep the full fit's. starts : candidate name -> physical start (joint
-    parameters and the values of its first effects, e.g. a single effect's fit for a pair).
+    and the folds keep the full fit's. starts : candidate name -> physical starts (joint
+    parameters and the values of its first effects, e.g. a single effect's fit for a pair);
+    the fit from each is made and the lowest E on all runs kept (default: theta_base).
     """
     cands = sorted(cands, key=lambda c: c.name != "baseline")
     if baseline is None and (not cands or cands[0].name != "baseline"):
@@ -136,8 +139,9 @@ def score_candidates(cands: Sequence[Candidate], runs: Sequence[RunEnvelope], th
     base_score = baseline.score if baseline is not None else None
     for c in cands:
         t0 = time.perf_counter()
-        start = (starts or {}).get(c.name, theta_base)
-        full = fit_candidate(c, runs, start, starts=1 if c.name == "baseline" else 3, max_nfev=max_nfev, refresh=1)
+        fits = [fit_candidate(c, runs, start, starts=1 if c.name == "baseline" else 3, max_nfev=max_nfev, refresh=1)
+                for start in (starts or {}).get(c.name, [theta_base])]
+        full = min(fits, key=lambda f: f.E)
         runs_c = with_transient(c, full.theta, runs)
         per = _held_out(c, runs_c, full, max_nfev, folds) if folds else {}
         if c.name == "baseline":
@@ -175,14 +179,19 @@ def needs_pairs(scored: Sequence[Scored], floor: float = 0.0) -> bool:
     return _within_scatter_drift(base.score, singles, None)
 
 
-def pair_names(scored: Sequence[Scored], library: Sequence[str]) -> list[str]:
-    """Pairs to try: the best single effect plus each other effect of `library`, and the runner-up's
-    when the best does not beat it decisively (a pair is named by the order its effects were added)."""
+def pair_bases(scored: Sequence[Scored]) -> list[str]:
+    """The single effects forward selection extends: the best, and the runner-up when the best does not
+    beat it decisively."""
     singles = _ranked(scored, False)
-    bases = [singles[0].name] + ([singles[1].name] if len(singles) > 1 and singles[0].score > MARGIN * singles[1].score
-                                 else [])
+    return [singles[0].name] + ([singles[1].name] if len(singles) > 1 and singles[0].score > MARGIN * singles[1].score
+                                else [])
+
+
+def pair_names(scored: Sequence[Scored], library: Sequence[str]) -> list[str]:
+    """Pairs to try: each base (`pair_bases`) plus each other effect of `library` (a pair is named by the
+    order its effects were added)."""
     out, seen = [], set()
-    for b in bases:
+    for b in pair_bases(scored):
         for e in library:
             key = frozenset((b, e))
             if e != b and key not in seen:

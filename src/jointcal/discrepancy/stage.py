@@ -35,7 +35,7 @@ from .fit import candidate, fit_candidate, model_at, with_transient
 from .floor import fast_floor
 from .library import EFFECTS, effects_of
 from .recalibrate import recalibrate
-from .select import RULE, confirm, decide, needs_pairs, pair_names, score_candidates
+from .select import RULE, confirm, decide, needs_pairs, pair_bases, pair_names, score_candidates
 from .words import diagnosis_markdown
 
 __all__ = ["DiscrepancySettings", "diagnose", "diagnosis_markdown", "valley_starts"]
@@ -180,13 +180,22 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     base = next(s for s in scored if s.name == "baseline")
     lap("singles")
     pairs_tried = []
+    if needs_pairs(scored, F):  # forward selection: the bases refit from the other valleys first
+        bases = pair_bases(scored)
+        fits = {s.name: s.fit.theta for s in scored}
+        refined = score_candidates([candidate(b, space, m) for b in bases], runs, theta0, baseline=base, log=say,
+                                   max_nfev=2 * settings.max_nfev,
+                                   starts={b: [fits[b]] + [np.r_[np.asarray(th, float)[:6], fits[b][6:]]
+                                                           for th in joint_starts] for b in bases})
+        better = {r.name: r for r in refined if r.fit.E < next(s for s in scored if s.name == r.name).fit.E}
+        scored = [better.get(s.name, s) for s in scored]
     if needs_pairs(scored, F):
         names = pair_names(scored, settings.candidates)
         say(f"{assembly}: no single effect closes the gap; forward selection tries {len(names)} pairs")
         fits = {s.name: s.fit.theta for s in scored}
         pc = [candidate(n, space, m) for n in names]
-        scored += score_candidates(pc, runs, theta0, max_nfev=settings.max_nfev, log=say, baseline=base,
-                                   starts={n: fits[effects_of(n)[0]] for n in names})
+        scored += score_candidates(pc, runs, theta0, max_nfev=2 * settings.max_nfev, log=say, baseline=base,
+                                   starts={n: [fits[effects_of(n)[0]]] for n in names})
         pairs_tried = names
     lap("pairs")
     # localise: residuals of the baseline refit, fingerprints
