@@ -228,7 +228,8 @@ def _diagnosis(effect, E0, E1, S_b, floor, candidates, **kw):
                       "effect_parameters": {p.name: {"value": p.start or 1.0, "unit": p.unit, "interval_90": [0.9, 1.1]}
                                             for e in eff for p in EFFECTS[e].params}})
     named = [] if effect in ("none", "unexplained") else effect.split("+")
-    rec = next((c["effect_parameters"] for c in cands if c["name"] == effect), {})
+    rec = {k: {**v, "value": 0.9 * v["value"]}  # recalibrated: moved from the scoring fit
+           for k, v in next((c["effect_parameters"] for c in cands if c["name"] == effect), {}).items()}
     return {"assembly": "a", "effect": effect, "effects": named, "confidence": kw.get("confidence", "high"),
             "metric_before": E0, "metric_after": E1, "baseline": {"held_out_score": S_b},
             "fast_model_floor": {"E": floor, "per_level": {"1": floor}}, "candidates": cands,
@@ -254,6 +255,7 @@ def test_the_words_never_contradict_the_verdict():
     pair = diagnosis_markdown(_diagnosis("fixture_flexibility+quadratic_damping", 9.0, 1.2, 9.5, 0.14,
                                          [("fixture_flexibility+quadratic_damping", 1.3), ("fixture_flexibility", 5.0)]))
     assert "Two missing effects" in pair and "fixture below the joint" in pair and "velocity" in pair
+    assert "near 5400 Hz" in pair  # the advice quotes the recalibrated values the list below gives
     assert "falls from 9.00 to 1.20" in pair
     worse = diagnosis_markdown(_diagnosis("sensor_gain", 6.0, 6.5, 7.0, 0.14, [("sensor_gain", 1.9)],
                                           confidence="low", note="name_not_confirmed"))

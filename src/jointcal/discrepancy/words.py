@@ -36,7 +36,7 @@ def _floor(d: Mapping) -> str:
     per = ", ".join(f"{k} g: {v:.2f}" for k, v in fl.get("per_level", {}).items())
     return (f"The fast model's own error on the calibrated model (its envelopes against the time simulation of the "
             f"same model, same runs and bins) is E = {fl['E']:.2f}" + (f" ({per})" if per else "") + ": "
-            + ("well below the repeat scatter, so the scores above measure the model, not the fast model."
+            + ("well below the repeat scatter, so the held-out scores measure the model, not the fast model."
                if fl["E"] <= 0.5 else "a share of the scores above is the fast model's own; the decision takes it out "
                "of the baseline's score." if fl["E"] <= 1.0 else
                "as large as the repeat scatter: the confidence is capped at medium."))
@@ -45,7 +45,8 @@ def _floor(d: Mapping) -> str:
 def _named(d: Mapping, E0: float, E1: float) -> list[str]:
     effects = d["effects"]
     c = next(c for c in d["candidates"] if c["name"] == d["effect"])
-    vals = {k: v["value"] for k, v in c["effect_parameters"].items()}
+    final = d["recalibrated"]["effect_parameters"] or c["effect_parameters"]  # the advice quotes the final model
+    vals = {k: v["value"] for k, v in final.items()}
     if len(effects) == 1:
         lines = [f"**Missing effect: `{effects[0]}`** (confidence {d['confidence']}).", ""]
     else:
