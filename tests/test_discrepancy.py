@@ -15,9 +15,10 @@ import pytest
 
 from jointcal.calibrate import CalibrateSettings, run_calibration
 from jointcal.calibrate.space import PARAMS
-from jointcal.discrepancy import EFFECTS, DiscrepancySettings, decide, diagnose, score_candidates
+from jointcal.discrepancy import EFFECTS, DiscrepancySettings, decide, diagnose, diagnosis_markdown, score_candidates
 from jointcal.discrepancy.data import RunEnvelope
 from jointcal.discrepancy.fit import candidate, envelope_E, model_at, predict
+from jointcal.discrepancy.select import NONE_E, Scored, confirm, needs_pairs, pair_names
 from jointcal.discrepancy.stage import valley_starts
 from jointcal.models import G
 
@@ -56,7 +57,7 @@ def test_effect_parameters_map_to_the_unit_cube_and_back():
 
 
 def test_a_new_library_effect_grows_the_space_and_is_fitted_without_other_changes(monkeypatch):
-    """Issue 9: the parameter space grows by an effect's parameters with no code change elsewhere.
+    """The parameter space grows by an effect's parameters with no code change elsewhere.
     A new entry (a base-channel gain error, the response read against a base that reads b high:
     T_read = T / b) is registered in the library only; the fit's space becomes the six joint columns
     plus b with its bounds and scaling, and the hidden b = 0.9 is recovered and named."""
@@ -135,6 +136,130 @@ def test_an_even_harmonic_no_library_effect_leaves_caps_the_decision():
     assert decide(partly, why)[:2] == ("unexplained", "low")
     assert decide(fully)[:2] == ("sensor_gain", "high")
     assert decide(fully, why)[:2] == ("sensor_gain", "medium")
+
+
+def _scored(name, score):
+    fit = type("F", (), {"E": score, "theta": np.zeros(9)})()
+    return Scored(name, fit, score)
+
+
+def test_two_effects_are_named_only_when_the_pair_closes_and_no_single_does():
+    """Forward selection: pairs are tried when the best single leaves the held-out score above the
+    'none' threshold; the pair is named when it closes the gap decisively (beats the best single and
+    the next pair by the margin), else the single rule stands."""
+    singles = [_scored("baseline", 12.0), _scored("fixture_flexibility", 6.0), _scored("quadratic_damping", 7.0),
+               _scored("sensor_gain", 11.0)]
+    assert needs_pairs(singles)
+    assert decide(singles)[:2] == ("unexplained", "low")  # 6 vs 7: not decisive
+    names = pair_names(singles, ["fixture_flexibility", "quadratic_damping", "sensor_gain"])
+    # the runner-up is not beaten decisively, so it is a base too; each pair once
+    assert names == ["fixture_flexibility+quadratic_damping", "fixture_flexibility+sensor_gain",
+                     "quadratic_damping+sensor_gain"]
+    pairs = [_scored(names[0], 1.4), _scored(names[1], 5.5), _scored(names[2], 6.5)]
+    assert decide(singles + pairs)[:2] == ("fixture_flexibility+quadratic_damping", "high")
+    close = [_scored(names[0], 1.4), _scored(names[1], 1.8), _scored(names[2], 6.5)]
+    assert decide(singles + close)[:2] == ("unexplained", "low")  # two pairs close alike: neither is named
+    one = [_scored("baseline", 12.0), _scored("sensor_gain", 1.3), _scored("channel_delay", 9.0)]
+    assert not needs_pairs(one) and decide(one)[:2] == ("sensor_gain", "high")
+    even = "the response's 2nd harmonic dominates"
+    assert decide(singles + pairs, even)[:2] == ("fixture_flexibility+quadratic_damping", "medium")
+
+
+def test_gain_and_delay_hidden_together_are_named_both():
+    """Envelopes of the true model with the response channel 10% high AND 40 us late: neither effect
+    alone predicts the held-out levels (magnitude or phase stays off), the pair does; both values recovered."""
+    runs = _runs("sensor_gain+channel_delay", [1.1, 4e-5], seed=5)
+    start = TRUTH * np.array([1.1, 0.95, 1.0, 1.0, 1.05, 1.2])
+    singles = score_candidates([candidate(n, SPACE, M) for n in ("baseline", "sensor_gain", "channel_delay")],
+                               runs, start, max_nfev=25)
+    assert needs_pairs(singles)
+    names = pair_names(singles, ["sensor_gain", "channel_delay"])
+    fits = {s.name: s.fit.theta for s in singles}
+    base = next(s for s in singles if s.name == "baseline")
+    pairs = score_candidates([candidate(n, SPACE, M) for n in names], runs, start, max_nfev=25, baseline=base,
+                             starts={n: [fits[n.split("+")[0]]] for n in names})
+    name, conf, ranked = decide(singles + pairs)
+    print("\n" + ", ".join(f"{s.name} {s.score:.2f}" for s in singles + pairs) + f" -> {name} ({conf})")
+    assert set(name.split("+")) == {"sensor_gain", "channel_delay"} and conf == "high"
+    c = candidate(name, SPACE, M)
+    got = dict(zip(c.names[6:], ranked[0].fit.theta[6:]))
+    assert abs(got["gain"] / 1.1 - 1) < 0.01 and abs(got["tau_s"] / 4e-5 - 1) < 0.05
+
+
+def test_the_fast_models_floor_is_taken_out_of_the_baseline_before_none():
+    """A baseline at 1.9 is 'unexplained' on a perfect fast model, 'none' when 1.2 of it is the fast
+    model's own error (sqrt(1.9^2 - 1.2^2) = 1.47 <= 1.5); a floor above the scatter caps confidence."""
+    sc = [_scored("baseline", 1.9), _scored("sensor_gain", 1.85), _scored("channel_delay", 1.88)]
+    assert decide(sc)[0] == "unexplained"
+    assert decide(sc, floor=1.2)[0] == "none"
+    strong = [_scored("baseline", 20.0), _scored("sensor_gain", 1.5), _scored("channel_delay", 15.0)]
+    assert decide(strong)[1] == "high" and decide(strong, floor=1.2)[1] == "medium"
+
+
+def test_within_the_scatter_only_a_drift_with_the_sequence_is_named():
+    """A baseline within the scatter is 'none' even if a candidate halves it, unless that candidate drifts
+    with the run sequence (its drift inflates the repeat scatter the baseline is judged by)."""
+    quad = [_scored("baseline", 0.63), _scored("quadratic_damping", 0.28), _scored("sensor_gain", 0.6)]
+    assert decide(quad)[0] == "none"
+    settle = [_scored("baseline", 1.2), _scored("joint_settling", 0.4), _scored("sensor_gain", 1.1)]
+    assert decide(settle)[:2] == ("joint_settling", "medium")
+    # the drift inflates the scatter: forward selection goes on from it, and a decisive pair is named
+    assert needs_pairs(settle) and not needs_pairs(quad)
+    with_cubic = [_scored("joint_settling+cubic_stiffening", 0.2), _scored("joint_settling+sensor_gain", 0.38)]
+    assert decide(settle + with_cubic)[:2] == ("joint_settling+cubic_stiffening", "medium")
+    alike = [_scored("joint_settling+cubic_stiffening", 0.3), _scored("joint_settling+sensor_gain", 0.35)]
+    assert decide(settle + alike)[:2] == ("joint_settling", "medium")
+
+
+def test_the_time_simulation_has_the_last_word():
+    assert confirm("none", "high", 0.37, 0.2) == ("none", "high", None)
+    assert confirm("none", "high", 0.4, 3.0) == ("none", "high", None)  # before within the scatter
+    assert confirm("none", "high", 2.5, 2.2) == ("unexplained", "low", "none_contradicted")
+    assert confirm("sensor_gain", "high", 6.0, 1.1) == ("sensor_gain", "high", None)
+    assert confirm("sensor_gain", "high", 6.0, 6.5) == ("sensor_gain", "low", "name_not_confirmed")
+
+
+def _diagnosis(effect, E0, E1, S_b, floor, candidates, **kw):
+    cands = []
+    for name, score in candidates:
+        eff = tuple(name.split("+"))
+        cands.append({"name": name, "effects": list(eff), "held_out_score": score, "fingerprints_for": [],
+                      "fingerprints_against": [f"not seen: {name} fingerprint"],
+                      "effect_parameters": {p.name: {"value": p.start or 1.0, "unit": p.unit, "interval_90": [0.9, 1.1]}
+                                            for e in eff for p in EFFECTS[e].params}})
+    named = [] if effect in ("none", "unexplained") else effect.split("+")
+    rec = {k: {**v, "value": 0.9 * v["value"]}  # recalibrated: moved from the scoring fit
+           for k, v in next((c["effect_parameters"] for c in cands if c["name"] == effect), {}).items()}
+    return {"assembly": "a", "effect": effect, "effects": named, "confidence": kw.get("confidence", "high"),
+            "metric_before": E0, "metric_after": E1, "baseline": {"held_out_score": S_b},
+            "fast_model_floor": {"E": floor, "per_level": {"1": floor}}, "candidates": cands,
+            "outside_library": kw.get("outside"), "time_domain_check": kw.get("note"),
+            "recalibrated": {"effect_parameters": rec}}
+
+
+def test_the_words_never_contradict_the_verdict():
+    none = diagnosis_markdown(_diagnosis("none", 0.37, 0.2, 1.1, 0.14, [("sensor_gain", 1.1)]))
+    assert "No missing effect" in none and "E = 0.37" in none and "misses" not in none
+    refit = diagnosis_markdown(_diagnosis("none", 2.4, 0.3, 1.1, 0.14, [("sensor_gain", 1.1)]))
+    assert "were off" in refit and "E = 0.30" in refit
+    # unexplained while the time domain is within the scatter: said to disagree, not "the model misses"
+    un = diagnosis_markdown(_diagnosis("unexplained", 0.37, 0.3, 1.9, 0.14,
+                                       [("sensor_gain", 1.8), ("sensor_gain+channel_delay", 1.7)],
+                                       outside="the response's 2nd harmonic is 7% of the fundamental"))
+    assert "disagree" in un and "misses" not in un
+    assert "`sensor_gain`" in un and "`sensor_gain+channel_delay`" in un  # everything tried
+    assert "E = 0.14" in un and "2nd harmonic is 7%" in un  # the floor and what points outside
+    contra = diagnosis_markdown(_diagnosis("unexplained", 2.5, 2.2, 1.2, 0.14, [("sensor_gain", 1.1)],
+                                           note="none_contradicted"))
+    assert "disagree" in contra and "within 1.20x" in contra
+    pair = diagnosis_markdown(_diagnosis("fixture_flexibility+quadratic_damping", 9.0, 1.2, 9.5, 0.14,
+                                         [("fixture_flexibility+quadratic_damping", 1.3), ("fixture_flexibility", 5.0)]))
+    assert "Two missing effects" in pair and "fixture below the joint" in pair and "velocity" in pair
+    assert "near 5400 Hz" in pair  # the advice quotes the recalibrated values the list below gives
+    assert "falls from 9.00 to 1.20" in pair
+    worse = diagnosis_markdown(_diagnosis("sensor_gain", 6.0, 6.5, 7.0, 0.14, [("sensor_gain", 1.9)],
+                                          confidence="low", note="name_not_confirmed"))
+    assert "does not fall" in worse and "does not confirm" in worse and "(confidence low)" in worse
 
 
 def test_bad_settings_are_one_sentence():

@@ -43,12 +43,15 @@ def main(smk) -> None:
         summary = json.loads(Path(smk.input.validation).read_text())
         space = CalibrateSettings.from_config(smk.params.calibrate).resolved(best).space
         starts = valley_starts(pd.read_csv(smk.input.history), best)
+        before_dir = Path(smk.input.validation).parent / "envelopes"
+        before = {p.stem: pd.read_csv(p) for p in before_dir.glob("*.csv")}
         n = max(1, int(smk.threads))
         with ProcessPoolExecutor(max_workers=n) as ex:
             out = diagnose(asm, envs, modal, best, summary.get("scale"), records, rows, space=space,
                            settings=settings, validate_settings=ValidateSettings.from_config(smk.params.validate),
                            envelopes_kw=dict(smk.params.envelopes), modal_kw=dict(smk.params.modal),
-                           metric_before=float(summary["E"]), joint_starts=starts, executor=ex if n > 1 else None, log=say)
+                           metric_before=float(summary["E"]), frames_before=before, joint_starts=starts,
+                           executor=ex if n > 1 else None, log=say)
     except (ValueError, KeyError) as exc:
         say(f"{asm}: {exc}")
         sys.exit(f"jointcal: {asm}: {exc}")
@@ -56,8 +59,6 @@ def main(smk) -> None:
     write_csv_atomic(out["residuals"], smk.output.residuals)
     write_csv_atomic(out["validation_after"].metrics, smk.output.metrics_after)
     write_bytes_atomic(diagnosis_markdown(d).encode(), smk.output.markdown)
-    before_dir = Path(smk.input.validation).parent / "envelopes"
-    before = {p.stem: pd.read_csv(p) for p in before_dir.glob("*.csv")}
     tmp_fig = Path(smk.output.residual_figure)
     residual_map_figure(out["residuals"], d, tmp_fig)
     before_after_figure(before, out["validation_after"].frames, d, Path(smk.output.before_after_figure))

@@ -4,7 +4,10 @@ Per usable run: the frames of its envelopes (drive on, not bad, at full drive, w
 a band around the measured resonance), their drive frequency, base amplitude, measured
 transmissibility response/base, the signed sweep rate, and the repeat-scatter scale of
 each frame's magnitude (dB) and phase (deg), the same bins as the validation error E
-(`jointcal.validate.error`).
+(`jointcal.validate.error`); and the run's drive as the envelopes measured it (every such
+frame's time, drive frequency and base amplitude, and the envelopes' window length,
+`jointcal.signal.window_length`), which the swept envelope model follows
+(`jointcal.models.swept`).
 """
 from __future__ import annotations
 
@@ -15,9 +18,11 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from ..models import SweepDrive
+from ..signal import window_length
 from ..validate.error import BINS
 
-__all__ = ["RunEnvelope", "run_envelope", "scale_arrays"]
+__all__ = ["RunEnvelope", "run_envelope", "run_zeta", "scale_arrays"]
 
 
 @dataclass(frozen=True)
@@ -27,7 +32,10 @@ class RunEnvelope:
     f_hz : drive frequency, Hz; base_g : base amplitude, g; T : measured transmissibility;
     sigma_db, sigma_deg : repeat scatter of magnitude and phase at each frame; rate : signed
     sweep rate df/dt, Hz/s; row : the manifest/modal row (run_id, level_g, direction,
-    sequence, f_res_hz, zeta_phase_resonance, ...).
+    sequence, f_res_hz, zeta_phase_resonance, ...); t_s : frame times, s; drive : the run's
+    measured drive (None: frames taken as a constant-rate sweep, no transient integrated);
+    transient : the sweep transient's factor on the first-order envelope at the frames
+    (`fit.with_transient`; None: 1).
     """
 
     f_hz: NDArray[np.float64]
@@ -37,6 +45,15 @@ class RunEnvelope:
     sigma_deg: NDArray[np.float64]
     rate: float
     row: dict
+    t_s: NDArray[np.float64] | None = None
+    drive: SweepDrive | None = None
+    transient: NDArray[np.complex128] | None = None
+
+
+def run_zeta(row: Mapping) -> float:
+    """A run's measured damping ratio: at phase resonance, else from the half-power width (NaN if neither)."""
+    zeta = float(row.get("zeta_phase_resonance", np.nan))
+    return zeta if np.isfinite(zeta) else float(row.get("zeta_half_power", np.nan))
 
 
 def scale_arrays(scale: Sequence[Mapping] | pd.DataFrame | None, floor_db: float = 0.05,
@@ -49,8 +66,21 @@ def scale_arrays(scale: Sequence[Mapping] | pd.DataFrame | None, floor_db: float
     return t["sigma_mag_db"].to_numpy(float), t["sigma_phase_deg"].to_numpy(float)
 
 
+def _window_s(row: Mapping, zeta_min: float) -> float | None:
+    """The envelopes' window length (s) for the run's manifest row, or None when the row lacks the sweep."""
+    try:
+        fs, rate = float(row["sample_rate_hz"]), float(row["sweep_rate_hz_per_s"])
+        f_low = min(float(row["f_start_hz"]), float(row["f_stop_hz"]))
+    except (KeyError, TypeError, ValueError):
+        return None
+    if not (np.isfinite(fs) and np.isfinite(rate) and np.isfinite(f_low) and rate > 0 and f_low > 0):
+        return None
+    return window_length(fs, rate, f_low, zeta_min=zeta_min) / fs
+
+
 def run_envelope(env: pd.DataFrame, row: Mapping, sigma_db: NDArray, sigma_deg: NDArray, *,
-                 band: tuple[float, float] = (0.6, 1.4), max_frames: int = 160) -> RunEnvelope | None:
+                 band: tuple[float, float] = (0.6, 1.4), max_frames: int = 160,
+                 zeta_min: float = 0.01) -> RunEnvelope | None:
     """The frames of one run used by the discrepancy fits (None when the run is unusable).
 
     Parameters
@@ -66,11 +96,11 @@ def run_envelope(env: pd.DataFrame, row: Mapping, sigma_db: NDArray, sigma_deg: 
         gain, delay and fixture fingerprints live off resonance).
     max_frames : int
         Frames kept at most (evenly thinned): the fits' cost.
+    zeta_min : float
+        The envelopes' setting of the same name (it sets their window length).
     """
     f_res = float(row.get("f_res_hz", np.nan))
-    zeta = float(row.get("zeta_phase_resonance", np.nan))
-    if not np.isfinite(zeta):
-        zeta = float(row.get("zeta_half_power", np.nan))
+    zeta = run_zeta(row)
     if not (np.isfinite(f_res) and np.isfinite(zeta) and zeta > 0) or "unusable" in str(row.get("flags", "")):
         return None
     ref = (env["ref_re"] + 1j * env["ref_im"]).to_numpy()
@@ -87,5 +117,9 @@ def run_envelope(env: pd.DataFrame, row: Mapping, sigma_db: NDArray, sigma_deg: 
     rate = float(np.median(np.gradient(f[ok], t[ok]))) if ok.sum() > 2 else 0.0
     x = np.abs(f[idx] / f_res - 1.0) / zeta
     b = np.clip(np.digitize(x, BINS[1:-1]), 0, len(BINS) - 2)
+    L = _window_s(row, zeta_min)
+    ok_t = np.flatnonzero(ok)
+    keep = ok_t[np.r_[True, np.diff(t[ok_t]) > 0]]
+    drive = (SweepDrive(t[keep], f[keep], np.abs(ref[keep]), L) if L is not None and keep.size >= 4 else None)
     return RunEnvelope(f_hz=f[idx], base_g=np.abs(ref[idx]), T=resp[idx] / ref[idx], sigma_db=sigma_db[b],
-                       sigma_deg=sigma_deg[b], rate=rate, row=dict(row))
+                       sigma_deg=sigma_deg[b], rate=rate, row=dict(row), t_s=t[idx], drive=drive)

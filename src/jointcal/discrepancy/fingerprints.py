@@ -1,8 +1,8 @@
 """Where measurement and model disagree: residual maps and the fingerprint features of each effect.
 
-Residuals are the measured transmissibility over the baseline model's (fast model, the
-sweep's first-order lag applied), in dB and degrees, divided by the repeat scatter of
-their bin. Fingerprints (PHYSICS.md, issue 9):
+Residuals are the measured transmissibility over the baseline model's (the swept fast
+model, `fit.predict`), in dB and degrees, divided by the repeat scatter of
+their bin. Fingerprints:
 
 ==========================  ==========================================================  ==================
 feature                     how                                                         points at

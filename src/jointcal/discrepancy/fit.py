@@ -1,16 +1,20 @@
 """Fit the baseline or a candidate model to the measured envelopes through the fast model.
 
 Objective: the validation error E (`jointcal.validate.envelope_error`) computed with the
-steady-state envelope model (`jointcal.models.steady_state`) instead of a time
-simulation: per frame the magnitude error (dB) and phase error (deg) of the model's
+swept envelope model (`jointcal.models.swept`) instead of a time simulation: per frame the magnitude error (dB) and phase error (deg) of the model's
 transmissibility against the measured one, each over the repeat scatter of its bin,
-every run weighted equally; E^2 = (E_mag^2 + E_phase^2) / 2. A steady-state model seen
-through a sweep lags: to first order in the sweep rate r (Hz/s, signed) a quasi-steady
-sweep shows T(f - r tau_g(f)), tau_g = -d arg T / d omega the group delay, which is
-applied to the model (the fits then do not mistake the sweep's lag for an effect).
+every run weighted equally; E^2 = (E_mag^2 + E_phase^2) / 2. The model's envelope is the
+one a sweep shows (`jointcal.models.swept`): the first-order quasi-steady envelope at
+each frame (`quasi_steady`, cheap and batched over parameter sets) times the run's
+transient factor, the slow flow integrated through the resonance over the first-order
+envelope, both at a reference parameter set (`with_transient`). A fit refreshes the factor
+at its optimum and refits from there (`fit_candidate(refresh=...)`): the factor changes
+little with the parameters, and at convergence the fitted envelope is the integrated one.
+So the fits do not mistake the sweep's lag, lower peak or ringing for an effect.
 
-Parameters live in a unit cube: the calibration's space (`jointcal.calibrate.space`)
-grown by the effect's own parameters (`ParamSpace.grow` with `library.EffectParam`'s
+A candidate is the baseline, one library effect, or several joined by '+' (present
+together). Parameters live in a unit cube: the calibration's space (`jointcal.calibrate.space`)
+grown by the effects' own parameters (`ParamSpace.grow` with `library.EffectParam`'s
 bounds and scaling). Bounded least squares (`scipy.optimize.least_squares`) from
 the baseline calibration and from each of the effect's start values; the Jacobian is one
 batched call of the fast model over the perturbed parameter sets.
@@ -18,7 +22,7 @@ batched call of the fast model over the perturbed parameter sets.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 
 import numpy as np
@@ -26,24 +30,34 @@ from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
 from ..calibrate.space import PARAMS, ParamSpace
-from ..models import IwanParams, MinistackModel, steady_state
-from .data import RunEnvelope
-from .library import EFFECTS, apply_effect
+from ..models import IwanParams, MinistackModel, quasi_steady, swept_transmissibility
+from .data import RunEnvelope, run_zeta
+from .library import EFFECTS, apply_effect, effects_of
 
-__all__ = ["Candidate", "Fit", "candidate", "model_at", "fit_candidate", "envelope_E", "predict"]
+__all__ = ["Candidate", "Fit", "candidate", "model_at", "fit_candidate", "envelope_E", "predict", "with_transient"]
 
 
 @dataclass(frozen=True)
 class Candidate:
-    """A model to fit: the baseline joint space grown by an effect's parameters ('baseline': none)."""
+    """A model to fit: the baseline joint space grown by its effects' parameters ('baseline': none;
+    'a+b': effects a and b together)."""
 
     name: str
     space: ParamSpace
     m: float
 
     @property
+    def effects(self) -> tuple[str, ...]:
+        return effects_of(self.name)
+
+    @property
     def effect_params(self):
-        return () if self.name == "baseline" else EFFECTS[self.name].params
+        return tuple(p for e in self.effects for p in EFFECTS[e].params)
+
+    @property
+    def sequence_dependent(self) -> bool:
+        """Whether the model changes with the run's place in the test sequence."""
+        return any(EFFECTS[e].sequence_dependent for e in self.effects)
 
     @cached_property
     def grown(self) -> ParamSpace:
@@ -65,8 +79,8 @@ class Candidate:
 
 
 def candidate(name: str, space: ParamSpace, m: float) -> Candidate:
-    if name != "baseline" and name not in EFFECTS:
-        raise ValueError(f"unknown candidate {name!r}; choose baseline or one of {', '.join(EFFECTS)}.")
+    """The candidate of a model name ('baseline', an effect, or effects joined by '+')."""
+    effects_of(name)  # one sentence for an unknown name
     return Candidate(name, space, m)
 
 
@@ -79,20 +93,38 @@ def model_at(c: Candidate, theta: NDArray, row: Mapping) -> MinistackModel:
     return apply_effect(base, c.name, values, row)
 
 
-def predict(c: Candidate, theta: NDArray, run: RunEnvelope) -> NDArray[np.complex128]:
-    """Model transmissibility at the run's frames as the sweep shows it (first-order lag), (P, n) or (n,)."""
+def _first_order(c: Candidate, theta: NDArray, run: RunEnvelope) -> NDArray[np.complex128]:
+    """The first-order quasi-steady envelope at the run's frames, (P, n) or (n,)."""
     model = model_at(c, theta, run.row)
     direction = "up" if run.rate >= 0 else "down"
-    T = steady_state(model, run.f_hz, run.base_g, direction=direction).transmissibility
-    order = np.argsort(run.f_hz)
-    f = run.f_hz[order]
-    Ts = T[..., order]
-    ph = np.unwrap(np.angle(Ts), axis=-1)
-    dT = np.gradient(Ts, f, axis=-1)
-    tau = -np.gradient(ph, 2 * np.pi * f, axis=-1)  # group delay, s
-    lagged = Ts - run.rate * tau * dT  # T(f - r tau_g), first order
-    out = np.empty_like(T)
-    out[..., order] = lagged
+    if run.drive is None or run.t_s is None:
+        rate, dlog = run.rate, 0.0
+    else:
+        _, _, rate, dlog = run.drive.at(run.t_s)
+    return quasi_steady(model, run.f_hz, run.base_g, rate_hz_per_s=rate, dlog_base_per_s=dlog, direction=direction)
+
+
+def predict(c: Candidate, theta: NDArray, run: RunEnvelope) -> NDArray[np.complex128]:
+    """Model transmissibility at the run's frames as the sweep shows it, (P, n) or (n,): the first-order
+    envelope times the run's transient factor (see the module notes)."""
+    T = _first_order(c, theta, run)
+    return T if run.transient is None else T * run.transient
+
+
+def with_transient(c: Candidate, theta: NDArray, runs: Sequence[RunEnvelope]) -> list[RunEnvelope]:
+    """The runs with their transient factor at parameters theta (n,): the integrated swept envelope
+    (`swept_transmissibility`) over the first-order one at each frame (1 where nothing is integrated)."""
+    out = []
+    for run in runs:
+        if run.drive is None or run.t_s is None:
+            out.append(replace(run, transient=None))
+            continue
+        model = model_at(c, np.asarray(theta, dtype=float)[:len(c.names)], run.row)
+        zeta = run_zeta(run.row)
+        swept = swept_transmissibility(model, run.drive, run.t_s, f_res_hz=float(run.row["f_res_hz"]), zeta=zeta)
+        with np.errstate(all="ignore"):
+            factor = swept / _first_order(c, theta, run)
+        out.append(replace(run, transient=np.where(np.isfinite(factor), factor, 1.0)))
     return out
 
 
@@ -128,27 +160,38 @@ class Fit:
 
 
 def fit_candidate(c: Candidate, runs: Sequence[RunEnvelope], theta0: NDArray, *, starts: int = 3,
-                  max_nfev: int = 60, free_joint: bool = True) -> Fit:
+                  max_nfev: int = 60, free_joint: bool = True, refresh: int = 0) -> Fit:
     """Bounded least squares of E^2 over the candidate's unit cube, from theta0 and effect start values.
 
     theta0 : (6,) or (n,) physical start (the baseline's joint parameters; effect values
     default to their `start`). starts : effect starts tried (the `start` value and evenly
-    spread points of the unit interval). free_joint : False holds the joint parameters.
+    spread points of the unit interval, for the effect parameters theta0 does not give). free_joint : False holds the joint parameters.
+    refresh : times the runs' transient factor is recomputed (at theta0 first, then at each
+    optimum, refitting from it); 0 keeps the runs' own factor.
     """
     n = len(c.names)
     th0 = np.empty(n)
     th0[:6] = np.asarray(theta0, dtype=float)[:6]
     for i, p in enumerate(c.effect_params):
         th0[6 + i] = theta0[6 + i] if len(theta0) > 6 + i else p.start
+    if refresh:
+        runs = with_transient(c, th0, runs)
+        fit = fit_candidate(c, runs, th0, starts=starts, max_nfev=max_nfev, free_joint=free_joint)
+        for _ in range(refresh):
+            runs = with_transient(c, fit.theta, runs)
+            again = fit_candidate(c, runs, fit.theta, starts=1, max_nfev=max_nfev, free_joint=free_joint)
+            fit = replace(again, n_eval=again.n_eval + fit.n_eval)
+        return fit
     u0 = np.clip(c.to_unit(th0), 1e-6, 1 - 1e-6)
     free = np.ones(n, bool) if free_joint else np.r_[np.zeros(6, bool), np.ones(n - 6, bool)]
     # beta is barely identifiable from envelopes and sits on its floor in most joints: held
     free[PARAMS.index("beta")] = False
     inits = [u0]
-    if n > 6:
+    new = max(6, len(theta0))  # effect parameters without a value in theta0 get spread starts
+    if n > new:
         for s in np.linspace(0.15, 0.85, max(0, starts - 1)):
             u = u0.copy()
-            u[6:] = s
+            u[new:] = s
             inits.append(u)
     h = 1e-5
     count = [0]

@@ -2,10 +2,12 @@
 
 Each effect is a model augmentation with one to three parameters (physical bounds and
 units) living in `MinistackModel`, so the steady-state envelope model
-(`jointcal.models.steady_state`), harmonic balance and the time simulation all see it.
+(`jointcal.models.swept`), harmonic balance and the time simulation all see it.
 An effect is one entry of `EFFECTS`: its parameters and a function
 (baseline model, values, manifest row) -> augmented model. Adding an effect is adding
 an entry here (and, if the structure lacks the physics, a field of `MinistackModel`).
+Effects present together are named by joining them with `JOIN` ("a+b") and applied in
+turn (`apply_effect`); their parameter names are distinct.
 
 =====================  =============================================  =====================================
 effect                 parameters                                     what it is
@@ -29,7 +31,7 @@ import numpy as np
 
 from ..models import Fixture, IwanParams, MinistackModel
 
-__all__ = ["EffectParam", "Effect", "EFFECTS", "apply_effect"]
+__all__ = ["EffectParam", "Effect", "EFFECTS", "apply_effect", "effects_of", "JOIN"]
 
 N_SETTLE = 3.0  # start value of the settling time, runs
 
@@ -112,10 +114,26 @@ EFFECTS: dict[str, Effect] = {e.name: e for e in (
 )}
 
 
-def apply_effect(model: MinistackModel, name: str, values: Mapping[str, float], row: Mapping) -> MinistackModel:
-    """The model with effect `name` at `values` for the run of manifest `row` ('baseline': unchanged)."""
+JOIN = "+"  # effects present together: "fixture_flexibility+quadratic_damping"
+
+
+def effects_of(name: str) -> tuple[str, ...]:
+    """The library effects of a model name: () for 'baseline', one or more joined by `JOIN`."""
     if name == "baseline":
-        return model
-    if name not in EFFECTS:
-        raise ValueError(f"unknown effect {name!r}; the library has {', '.join(EFFECTS)}.")
-    return EFFECTS[name].apply(model, values, row)
+        return ()
+    parts = tuple(name.split(JOIN))
+    bad = [p for p in parts if p not in EFFECTS]
+    if bad or len(set(parts)) != len(parts):
+        raise ValueError(f"unknown effect(s) {', '.join(bad) or name!r}; the library has {', '.join(EFFECTS)} "
+                         f"(join distinct effects with {JOIN!r}).")
+    return parts
+
+
+def apply_effect(model: MinistackModel, name: str, values: Mapping[str, float], row: Mapping) -> MinistackModel:
+    """The model with effect(s) `name` at `values` for the run of manifest `row` ('baseline': unchanged).
+
+    Joined effects ("a+b") are applied in turn; each reads its own parameters from `values`
+    (parameter names are distinct across the library)."""
+    for e in effects_of(name):
+        model = EFFECTS[e].apply(model, values, row)
+    return model

@@ -2,7 +2,8 @@
 
 1. GA (`jointcal.calibrate.run_ga`, DEAP) over the candidate's unit cube (the calibration's
    space grown by the effect's parameters, `ParamSpace.grow`); objective E^2 of the fast
-   model over all runs (`fit.residuals`, one batched call per generation). The seeded
+   model over all runs (`fit.residuals`, one batched call per generation; the sweep
+   transient at the best least-squares start, refreshed at the polished optimum). The seeded
    initial population holds the candidate's least-squares fits (from the calibration's
    optimum and from the GA's other Fs valleys), so the GA explores around and between them.
 2. Polish: bounded least squares from the GA's best (`fit.fit_candidate`).
@@ -31,7 +32,7 @@ from ..calibrate.ga import GAOptions, run_ga
 from ..calibrate.space import PARAMS
 from ..posterior.sampler import run_chain
 from .data import RunEnvelope
-from .fit import Candidate, Fit, fit_candidate, residuals
+from .fit import Candidate, Fit, fit_candidate, residuals, with_transient
 
 __all__ = ["Recalibration", "recalibrate"]
 
@@ -79,6 +80,7 @@ def recalibrate(c: Candidate, runs: Sequence[RunEnvelope], starts: Sequence[Fit]
     free = np.ones(n, bool)
     free[PARAMS.index("beta")] = False
     held = [np.clip(c.to_unit(min(starts, key=lambda f: f.E).theta), 0.0, 1.0)]
+    runs = with_transient(c, min(starts, key=lambda f: f.E).theta, runs)  # the sweep transient at the best start
 
     def full(V: NDArray) -> NDArray:
         U = np.repeat(held[0][None], len(V), axis=0)
@@ -91,9 +93,10 @@ def recalibrate(c: Candidate, runs: Sequence[RunEnvelope], starts: Sequence[Fit]
     init = np.array([np.clip(c.to_unit(f.theta), 0.0, 1.0)[free] for f in starts]).reshape(-1, int(free.sum()))
     ga = run_ga(batch, int(free.sum()), GAOptions(population=population, offspring=population,
                                                    generations=generations, stall_generations=8, seed=seed), init=init)
-    pol = fit_candidate(c, runs, c.to_physical(full(ga.best[None])[0]), starts=1, max_nfev=max_nfev)
+    pol = fit_candidate(c, runs, c.to_physical(full(ga.best[None])[0]), starts=1, max_nfev=max_nfev, refresh=1)
     best = min([pol, *starts], key=lambda f: f.E)
     held[0] = np.clip(c.to_unit(best.theta), 0.0, 1.0)  # the chain holds beta at the chosen fit's value
+    runs = with_transient(c, best.theta, runs)
     n_res = residuals(c, best.theta, runs).size
     temp = max(best.E**2, 1.0)
 

@@ -1,11 +1,11 @@
-"""Decide: refit the baseline and every library candidate, score them on runs they did not fit, name one.
+"""Decide: refit the baseline and every library candidate, score them on runs they did not fit, name them.
 
 Held-out score. For each tested level L (with at least two levels), every model is refit
 on the runs of the other levels (warm started from its fit on all runs) and its fast-model
 E is taken on the runs of level L; likewise each sweep direction is predicted from the
 runs of the other (up and down runs interleave in the sequence, so a drift with the run
 sequence is judged on runs between fitted ones). The score is the RMS of those E over the
-folds. A model that changes with the run sequence (`Effect.sequence_dependent`) is not
+folds. A model that changes with the run sequence (`Candidate.sequence_dependent`) is not
 judged on a fold whose held-out runs lie mostly outside the fitted runs' span of the
 sequence (holding out the 1 g level removes the start of a Table 3.1 series: the drift would
 be extrapolated backward past every fitted run); its score is the baseline's over all folds
@@ -14,25 +14,18 @@ held-out runs penalise flexibility (an extra parameter that only absorbs the fit
 runs' noise predicts the unseen level no better), and a further complexity penalty of
 `PENALTY_PER_PARAM` (relative, per extra parameter) is applied to the score.
 
-Decision rule (scores S; S_b the baseline's, S_1 <= S_2 the two best candidates'):
+Forward selection. When the best single effect leaves a held-out score above `NONE_E`, or
+is a drift with the run sequence found within the scatter (the drift inflates the repeat
+scatter, so a second effect may hide in it) (`needs_pairs`), the best single (and the
+runner-up, if the best does not beat it decisively, `pair_bases`) is first refit from the
+calibration's other valleys too, with the effort a pair gets (a pair must not win by
+the optimiser's luck alone); if it still leaves the gap, each other effect is added to it:
+the pairs are fitted and scored the same way, on the same folds, with the penalty for all
+their parameters (`pair_names`).
 
-* ``none``        when S_b <= `NONE_E` (the baseline already predicts unseen levels within
-                  1.5x the measured repeat scatter) -- unless the best candidate predicts
-                  them far better still, S_1 <= `WITHIN_SCATTER` S_b, and decisively
-                  (S_1 <= MARGIN S_2): then the "scatter" itself is systematic (repeats
-                  that drift with the sequence inflate the repeat scatter they are judged
-                  by) and the candidate is named with confidence 'medium';
-* the best name   when it closes at least `CLOSE_FRACTION` of the baseline's excess gap,
-                  S_b - S_1 >= CLOSE_FRACTION (S_b - 1), AND beats the runner-up decisively,
-                  S_1 <= `MARGIN` S_2; confidence 'high' if it also reaches S_1 <= 2 (the
-                  gap closed to about the scatter), else 'medium';
-* ``unexplained`` otherwise: the gap is real and no single library effect closes it (or two
-                  close it equally well); the ranked candidates and the fingerprints that
-                  disagree with each are reported.
-
-A fingerprint no library effect can leave (`fingerprints.outside_library`: a dominant even
-harmonic) caps the decision: the best name is kept only if it closes the gap to about the
-scatter (S_1 <= 2), and then with confidence 'medium'; otherwise ``unexplained``.
+The fast model's floor F (its own error against the time simulation of the calibrated model
+on the same runs and bins, `floor.fast_floor`) is taken out of the baseline's score before
+the 'none' test: S_b' = sqrt(max(S_b^2 - F^2, 0)).
 """
 from __future__ import annotations
 
@@ -43,21 +36,37 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .data import RunEnvelope
-from .fit import Candidate, Fit, envelope_E, fit_candidate
-from .library import EFFECTS
+from .fit import Candidate, Fit, envelope_E, fit_candidate, with_transient
+from .library import EFFECTS, JOIN, effects_of
 
-__all__ = ["NONE_E", "CLOSE_FRACTION", "MARGIN", "PENALTY_PER_PARAM", "WITHIN_SCATTER", "Scored", "score_candidates", "decide"]
+__all__ = ["NONE_E", "CLOSE_FRACTION", "MARGIN", "PENALTY_PER_PARAM", "WITHIN_SCATTER", "FLOOR_HIGH", "Scored",
+           "score_candidates", "needs_pairs", "pair_bases", "pair_names", "decide", "confirm", "RULE"]
 
 NONE_E = 1.5
 CLOSE_FRACTION = 0.6
 MARGIN = 0.7
 PENALTY_PER_PARAM = 0.02
 WITHIN_SCATTER = 0.5
+FLOOR_HIGH = 1.0  # a fast-model floor above this (the repeat scatter) caps every confidence at medium
+
+RULE = (f"Scores S are held-out fast-model E (1 = the repeat scatter), S_b the baseline's, F the fast model's "
+        f"floor. 'none' if sqrt(S_b^2 - F^2) <= {NONE_E} (unless the best single effect changes with the run "
+        f"sequence, whose drift inflates the repeat scatter, and scores <= {WITHIN_SCATTER} x S_b and <= {MARGIN} x "
+        "the runner-up: named, medium; forward selection then goes on from it, and a pair with it that scores "
+        f"<= {MARGIN} x it and x the next pair is named instead, medium). Otherwise a single effect is "
+        f"named if it closes >= {CLOSE_FRACTION:.0%} of the baseline's excess over 1 and scores <= {MARGIN} x "
+        f"the runner-up (high when its score <= 2). If the best single scores above {NONE_E}, effects are added "
+        f"to it one at a time (forward selection); a pair is named instead when it closes >= "
+        f"{CLOSE_FRACTION:.0%} of the excess, scores <= {MARGIN} x the best single and <= {MARGIN} x the next "
+        "pair (high when its score <= 2). Otherwise unexplained. A fingerprint no library effect leaves (a "
+        f"dominant even harmonic) keeps a name only at score <= 2, with confidence medium; a floor F > "
+        f"{FLOOR_HIGH} caps confidence at medium. A 'none' the time simulation contradicts (E > {NONE_E} before "
+        "and after the refit) becomes unexplained.")
 
 
 @dataclass
 class Scored:
-    """A candidate's full fit, its held-out score and per-level E, and the time it took."""
+    """A candidate's full fit, its held-out score and per-fold E, and the time it took."""
 
     name: str
     fit: Fit
@@ -97,9 +106,8 @@ def _held_out(c: Candidate, runs: Sequence[RunEnvelope], full: Fit, max_nfev: in
               folds: dict[str, list[int]]) -> dict[str, float]:
     """E of the candidate refit without each fold, on that fold (folds it cannot be judged on left out)."""
     per = {}
-    seq_dep = c.name != "baseline" and EFFECTS[c.name].sequence_dependent
     for name, idx in folds.items():
-        if seq_dep and _extrapolates_sequence(runs, idx):
+        if c.sequence_dependent and _extrapolates_sequence(runs, idx):
             continue
         test = [runs[i] for i in idx]
         train = [r for i, r in enumerate(runs) if i not in set(idx)]
@@ -113,27 +121,39 @@ def _rms(values) -> float:
 
 
 def score_candidates(cands: Sequence[Candidate], runs: Sequence[RunEnvelope], theta_base, *,
-                     max_nfev: int = 40, log=None) -> list[Scored]:
+                     max_nfev: int = 40, log=None, baseline: Scored | None = None,
+                     starts: dict[str, Sequence[np.ndarray]] | None = None) -> list[Scored]:
     """Fit every candidate on all runs, then score it on held-out folds (see the module notes).
-    The baseline is scored first (added if `cands` lacks it): the other scores refer to it."""
+
+    The baseline is scored first (added if `cands` lacks it and `baseline` is not given): the
+    other scores refer to it. Each fit refreshes the runs' sweep transient at its optimum,
+    and the folds keep the full fit's. starts : candidate name -> physical starts (joint
+    parameters and the values of its first effects, e.g. a single effect's fit for a pair);
+    the fit from each is made and the lowest E on all runs kept (default: theta_base).
+    """
     cands = sorted(cands, key=lambda c: c.name != "baseline")
-    if cands[0].name != "baseline":
+    if baseline is None and (not cands or cands[0].name != "baseline"):
         cands = [Candidate("baseline", cands[0].space, cands[0].m), *cands]
     folds = _folds(runs)
-    out, base_per = [], {}
+    out, base_per = [], (baseline.held_out if baseline is not None else {})
+    base_score = baseline.score if baseline is not None else None
     for c in cands:
         t0 = time.perf_counter()
-        full = fit_candidate(c, runs, theta_base, starts=1 if c.name == "baseline" else 3, max_nfev=max_nfev)
-        per = _held_out(c, runs, full, max_nfev, folds) if folds else {}
+        fits = [fit_candidate(c, runs, start, starts=1 if c.name == "baseline" else 3, max_nfev=max_nfev, refresh=1)
+                for start in (starts or {}).get(c.name, [theta_base])]
+        full = min(fits, key=lambda f: f.E)
+        runs_c = with_transient(c, full.theta, runs)
+        per = _held_out(c, runs_c, full, max_nfev, folds) if folds else {}
         if c.name == "baseline":
             base_per = per
             s = _rms(per.values()) if per else full.E
+            base_score = s
         elif not folds:
             s = full.E
         elif len(per) == len(folds):
             s = _rms(per.values())
         else:  # judged on a subset of the folds: relative to the baseline on the same subset
-            s = _rms(base_per.values()) * _rms(per.values()) / _rms([base_per[k] for k in per])
+            s = base_score * _rms(per.values()) / _rms([base_per[k] for k in per])
         s *= 1.0 + PENALTY_PER_PARAM * (len(c.names) - 6)
         out.append(Scored(c.name, full, s, per, time.perf_counter() - t0))
         if log:
@@ -141,25 +161,119 @@ def score_candidates(cands: Sequence[Candidate], runs: Sequence[RunEnvelope], th
     return out
 
 
-def decide(scored: Sequence[Scored], outside: str | None = None) -> tuple[str, str, list[Scored]]:
-    """(effect or 'none'/'unexplained', confidence, candidates ranked by score) by the module's rule.
+def _ranked(scored: Sequence[Scored], pairs: bool) -> list[Scored]:
+    return sorted((s for s in scored if s.name != "baseline" and (len(effects_of(s.name)) > 1) == pairs),
+                  key=lambda s: s.score)
 
-    outside : a fingerprint no library effect leaves (`fingerprints.outside_library`), or None.
+
+def needs_pairs(scored: Sequence[Scored], floor: float = 0.0) -> bool:
+    """Whether forward selection goes on to pairs: the baseline misses and no single effect brings the
+    held-out score down to `NONE_E`; or the single named is a drift with the run sequence found within
+    the scatter (that scatter is then partly the drift's, and judged without it a second effect may show)."""
+    base = next(s for s in scored if s.name == "baseline")
+    singles = _ranked(scored, False)
+    if not singles:
+        return False
+    if _above_floor(base.score, floor) > NONE_E:
+        return singles[0].score > NONE_E
+    return _within_scatter_drift(base.score, singles, None)
+
+
+def pair_bases(scored: Sequence[Scored]) -> list[str]:
+    """The single effects forward selection extends: the best, and the runner-up when the best does not
+    beat it decisively."""
+    singles = _ranked(scored, False)
+    return [singles[0].name] + ([singles[1].name] if len(singles) > 1 and singles[0].score > MARGIN * singles[1].score
+                                else [])
+
+
+def pair_names(scored: Sequence[Scored], library: Sequence[str]) -> list[str]:
+    """Pairs to try: each base (`pair_bases`) plus each other effect of `library` (a pair is named by the
+    order its effects were added)."""
+    out, seen = [], set()
+    for b in pair_bases(scored):
+        for e in library:
+            key = frozenset((b, e))
+            if e != b and key not in seen:
+                seen.add(key)
+                out.append(f"{b}{JOIN}{e}")
+    return out
+
+
+def _above_floor(score: float, floor: float) -> float:
+    return float(np.sqrt(max(score**2 - floor**2, 0.0)))
+
+
+def decide(scored: Sequence[Scored], outside: str | None = None, *, floor: float = 0.0
+           ) -> tuple[str, str, list[Scored]]:
+    """(effect(s) or 'none'/'unexplained', confidence, candidates ranked by score) by `RULE`.
+
+    scored : the baseline, single effects and any pairs ('a+b'). outside : a fingerprint no
+    library effect leaves (`fingerprints.outside_library`), or None. floor : the fast model's
+    own error F (E units).
     """
     base = next(s for s in scored if s.name == "baseline")
-    ranked = sorted((s for s in scored if s.name != "baseline"), key=lambda s: s.score)
-    s1 = ranked[0].score if ranked else np.inf
-    s2 = ranked[1].score if len(ranked) > 1 else np.inf
-    if base.score <= NONE_E:
-        if s1 <= WITHIN_SCATTER * base.score and s1 <= MARGIN * s2 and not outside:
-            return ranked[0].name, "medium", ranked
-        return "none", "high" if (not ranked or s1 > 0.8 * base.score) else "medium", ranked
-    if not ranked:
-        return "unexplained", "low", ranked
-    closes = base.score - s1 >= CLOSE_FRACTION * (base.score - 1.0)
-    decisive = s1 <= MARGIN * s2
-    if closes and decisive and outside and s1 > 2.0:
-        return "unexplained", "low", ranked
-    if closes and decisive:
-        return ranked[0].name, "high" if (s1 <= 2.0 and not outside) else "medium", ranked
-    return "unexplained", "low", ranked
+    singles, pairs = _ranked(scored, False), _ranked(scored, True)
+    ranked = sorted(singles + pairs, key=lambda s: s.score)
+    s1 = singles[0].score if singles else np.inf
+    s2 = singles[1].score if len(singles) > 1 else np.inf
+    name, conf = _rule(base.score, s1, s2, singles, pairs, outside, floor)
+    if conf == "high" and floor > FLOOR_HIGH:
+        conf = "medium"
+    return name, conf, ranked
+
+
+def _drifts(name: str) -> bool:
+    """Whether the model changes with the run sequence: its drift inflates the repeat scatter it is judged by."""
+    return any(EFFECTS[e].sequence_dependent for e in effects_of(name))
+
+
+def _closes(sb: float, s: float) -> bool:
+    return sb - s >= CLOSE_FRACTION * (sb - 1.0)
+
+
+def _within_scatter_drift(sb: float, singles: Sequence[Scored], outside) -> bool:
+    """The within-scatter branch of the rule: the best single drifts with the sequence and halves the baseline."""
+    s1 = singles[0].score if singles else np.inf
+    s2 = singles[1].score if len(singles) > 1 else np.inf
+    return bool(singles) and _drifts(singles[0].name) and s1 <= WITHIN_SCATTER * sb and s1 <= MARGIN * s2 and not outside
+
+
+def _pair_wins(pairs: Sequence[Scored], s1: float) -> bool:
+    """The best pair beats the best single and the next pair by the margin."""
+    p1 = pairs[0].score
+    p2 = pairs[1].score if len(pairs) > 1 else np.inf
+    return p1 <= MARGIN * s1 and p1 <= MARGIN * p2
+
+
+def _rule(sb, s1, s2, singles, pairs, outside, floor) -> tuple[str, str]:
+    if _above_floor(sb, floor) <= NONE_E:
+        if _within_scatter_drift(sb, singles, outside):
+            if pairs and _drifts(pairs[0].name) and _pair_wins(pairs, s1):
+                return pairs[0].name, "medium"
+            return singles[0].name, "medium"
+        return "none", "high" if (not singles or s1 > 0.8 * sb) else "medium"
+    if pairs:
+        p1 = pairs[0].score
+        if _closes(sb, p1) and _pair_wins(pairs, s1) and not (outside and p1 > 2.0):
+            return pairs[0].name, "high" if (p1 <= 2.0 and not outside) else "medium"
+    if not singles:
+        return "unexplained", "low"
+    if _closes(sb, s1) and s1 <= MARGIN * s2 and not (outside and s1 > 2.0):
+        return singles[0].name, "high" if (s1 <= 2.0 and not outside) else "medium"
+    return "unexplained", "low"
+
+
+def confirm(effect: str, confidence: str, e_before: float, e_after: float) -> tuple[str, str, str | None]:
+    """The time simulation's word on a decision: (effect, confidence, note) by the end of `RULE`.
+
+    e_before, e_after : the time-domain E of the calibrated model and of the decided model
+    recalibrated. 'none' with both above `NONE_E` is contradicted (-> 'unexplained', note
+    'none_contradicted'); a name whose E does not fall, from above `NONE_E`, is not confirmed
+    (confidence 'low', note 'name_not_confirmed').
+    """
+    if effect == "none" and min(e_before, e_after) > NONE_E:
+        return "unexplained", "low", "none_contradicted"
+    if effect not in ("none", "unexplained") and e_after >= e_before and e_before > NONE_E:
+        return effect, "low", "name_not_confirmed"
+    return effect, confidence, None

@@ -1,16 +1,21 @@
 """The discrepancy stage for one assembly: localise, score the library, decide, act, report.
 
+0. Floor: the fast model's own error on the calibrated model, against the validation's
+   time simulation of it on the same runs and bins (`floor.fast_floor`).
 1. Localise: the baseline (the calibration's optimum, refit on the envelopes) against
    the measured envelopes; residual map and fingerprints (`fingerprints`).
 2. Candidates: the baseline and every library effect (`library.EFFECTS`), each refit on
-   the envelopes through the fast model (`fit`), scored on held-out levels (`select`).
-3. Decide by `select.decide`'s rule.
-4. Act: the named effect's model recalibrated with the joint parameters (`recalibrate`:
+   the envelopes through the fast model (`fit`), scored on held-out levels (`select`);
+   when no single effect brings the score to the scatter, pairs by forward selection.
+3. Decide by `select.decide`'s rule (`select.RULE`).
+4. Act: the named model recalibrated with the joint parameters (`recalibrate`:
    DEAP GA over the grown space seeded with the least-squares fits from the calibration's
    optimum and its other valleys, polish, emcee posterior for the 90% intervals),
    revalidated by the TIME simulation driven by each run's measured base record
    (`jointcal.validate.validate_runs`, the validation stage's E: same definition, same
-   runs) -> metric_before, metric_after.
+   runs) -> metric_before, metric_after. A 'none' that the time simulation contradicts
+   (E above `select.NONE_E` before and after) becomes 'unexplained'; a name the time
+   simulation does not confirm (E not lower after) keeps confidence low.
 """
 from __future__ import annotations
 
@@ -26,10 +31,12 @@ from ..models import harmonic_balance
 from ..validate import ValidateSettings, model_from_best, validate_runs
 from .data import run_envelope, scale_arrays
 from .fingerprints import fingerprints, outside_library, residual_map, verdicts
-from .fit import candidate, fit_candidate, model_at
+from .fit import candidate, fit_candidate, model_at, with_transient
+from .floor import fast_floor
+from .library import EFFECTS, effects_of
 from .recalibrate import recalibrate
-from .library import EFFECTS
-from .select import CLOSE_FRACTION, MARGIN, NONE_E, WITHIN_SCATTER, decide, score_candidates
+from .select import RULE, confirm, decide, needs_pairs, pair_bases, pair_names, score_candidates
+from .words import diagnosis_markdown
 
 __all__ = ["DiscrepancySettings", "diagnose", "diagnosis_markdown", "valley_starts"]
 
@@ -98,11 +105,23 @@ def _interval(fit, c, i) -> list[float]:
     return [float(c.to_physical(lo)[i]), float(c.to_physical(hi)[i])]
 
 
+def _candidate_json(s, space, m, ver) -> dict:
+    c = candidate(s.name, space, m)
+    eff = {p.name: {"value": float(s.fit.theta[6 + i]), "unit": p.unit, "interval_90": _interval(s.fit, c, 6 + i)}
+           for i, p in enumerate(c.effect_params)}
+    return {"name": s.name, "effects": list(c.effects), "held_out_score": s.score, "E_fit": s.fit.E,
+            "held_out_E_per_level": s.held_out, "effect_parameters": eff,
+            "joint_parameters": dict(zip(PARAMS, map(float, s.fit.theta[:6]))),
+            "fingerprints_for": [w for e in c.effects for w in ver[e]["for"]],
+            "fingerprints_against": [w for e in c.effects for w in ver[e]["against"]], "seconds": s.seconds}
+
+
 def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFrame, best: Mapping,
              scale: Sequence[Mapping] | None, records: Sequence[pd.DataFrame], rows: Sequence[Mapping], *,
              space: ParamSpace, settings: DiscrepancySettings = DiscrepancySettings(),
              validate_settings: ValidateSettings = ValidateSettings(), envelopes_kw: dict | None = None,
-             modal_kw: dict | None = None, metric_before: float | None = None, executor=None,
+             modal_kw: dict | None = None, metric_before: float | None = None,
+             frames_before: Mapping[str, pd.DataFrame] | None = None, executor=None,
              joint_starts: Sequence[Sequence[float]] = (), log: Callable[[str], None] | None = None) -> dict:
     """Diagnose one assembly; returns the diagnosis (diagnosis.json's content plus tables and models).
 
@@ -110,8 +129,10 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     ----------
     envs : run_id -> envelopes DataFrame; modal : modal_properties.csv rows (all assemblies);
     best : the calibration's ga_best.json; scale : the validation's repeat-scatter bins
-    (summary.json's "scale"; None: the calibrated model is validated here first, as the
-    validation stage does, and its scale and E are used); records, rows : measured records and manifest rows of the
+    (summary.json's "scale"); frames_before : the validation's compared frames of the
+    calibrated model (run_id -> its envelopes/<run_id>.csv); when either is None the
+    calibrated model is validated here first, as the validation stage does, and its scale,
+    frames and E are used; records, rows : measured records and manifest rows of the
     assembly's runs (for the time-simulation revalidation); metric_before : the validation
     stage's E (recomputed when None); joint_starts : further joint parameter sets (6,) from
     which the final model is also refit (e.g. the GA's best individual in each other valley:
@@ -119,34 +140,67 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     """
     say = log or (lambda s: None)
     t_start = time.perf_counter()
+    clock = {}
+
+    def lap(step: str) -> None:  # seconds per step of the stage, for diagnosis.json
+        clock[step] = time.perf_counter() - t_start - sum(clock.values())
     m = float(best["m"])
     theta0 = np.array([best[p] for p in PARAMS], dtype=float)
-    if scale is None:  # as the validation stage does: the calibrated model's E and the measured repeat scatter
+    if scale is None or frames_before is None:  # as the validation stage does: the calibrated model in time
         v_before = validate_runs([model_from_best(best) for _ in rows], records, rows, settings=validate_settings,
                                  envelopes_kw=envelopes_kw, modal_kw=modal_kw, executor=executor)
-        scale = v_before.scale.to_dict(orient="records")
+        scale = v_before.scale.to_dict(orient="records") if scale is None else scale
+        frames_before = v_before.frames
         metric_before = float(v_before.error["E"]) if metric_before is None else metric_before
+    lap("validate_before")
     sdb, sdeg = scale_arrays(scale)
     mrows = modal[modal["assembly"] == assembly].set_index("run_id")
+    zeta_min = float((envelopes_kw or {}).get("zeta_min", 0.01))
     runs = []
     for row in rows:
         rid = row["run_id"]
         if rid not in mrows.index or rid not in envs:
             continue
         r = run_envelope(envs[rid], {**dict(row), **mrows.loc[rid].to_dict(), "run_id": rid}, sdb, sdeg,
-                         band=settings.band, max_frames=settings.max_frames)
+                         band=settings.band, max_frames=settings.max_frames, zeta_min=zeta_min)
         if r is not None:
             runs.append(r)
     if len(runs) < 2:
         raise ValueError(f"assembly {assembly}: {len(runs)} usable run(s); the discrepancy workflow needs at "
                          "least two usable runs (at two levels to score held-out levels).")
     say(f"{assembly}: {len(runs)} usable runs, {sum(r.f_hz.size for r in runs)} envelope frames")
-    cands = [candidate("baseline", space, m)] + [candidate(n, space, m) for n in settings.candidates]
+    c0 = candidate("baseline", space, m)
+    floor = fast_floor(c0, theta0, runs, frames_before, sdb, sdeg)
+    F = floor["E"] if floor["E"] is not None else 0.0
+    say(f"{assembly}: the fast model's floor (its envelope of the calibrated model against the time simulation) "
+        f"E = {F:.2f}" + ("" if floor["E"] is not None else " (no validation frames to compare: taken as 0)"))
+    lap("floor")
+    cands = [c0] + [candidate(n, space, m) for n in settings.candidates]
     scored = score_candidates(cands, runs, theta0, max_nfev=settings.max_nfev, log=say)
     base = next(s for s in scored if s.name == "baseline")
+    lap("singles")
+    pairs_tried = []
+    if needs_pairs(scored, F):  # forward selection: the bases refit from the other valleys first
+        bases = pair_bases(scored)
+        fits = {s.name: s.fit.theta for s in scored}
+        refined = score_candidates([candidate(b, space, m) for b in bases], runs, theta0, baseline=base, log=say,
+                                   max_nfev=2 * settings.max_nfev,
+                                   starts={b: [fits[b]] + [np.r_[np.asarray(th, float)[:6], fits[b][6:]]
+                                                           for th in joint_starts] for b in bases})
+        better = {r.name: r for r in refined if r.fit.E < next(s for s in scored if s.name == r.name).fit.E}
+        scored = [better.get(s.name, s) for s in scored]
+    if needs_pairs(scored, F):
+        names = pair_names(scored, settings.candidates)
+        say(f"{assembly}: no single effect closes the gap; forward selection tries {len(names)} pairs")
+        fits = {s.name: s.fit.theta for s in scored}
+        pc = [candidate(n, space, m) for n in names]
+        scored += score_candidates(pc, runs, theta0, max_nfev=2 * settings.max_nfev, log=say, baseline=base,
+                                   starts={n: [fits[effects_of(n)[0]]] for n in names})
+        pairs_tried = names
+    lap("pairs")
     # localise: residuals of the baseline refit, fingerprints
-    c0 = cands[0]
-    res = residual_map(c0, base.fit.theta, runs)
+    runs_b = with_transient(c0, base.fit.theta, runs)
+    res = residual_map(c0, base.fit.theta, runs_b)
     usable = mrows.loc[[r.row["run_id"] for r in runs]].reset_index()
     jb = dict(zip(PARAMS, base.fit.theta))
     model_fz = {}
@@ -158,29 +212,21 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     fp = fingerprints(res, usable, model_fz, jb, max(scatter_f, 2e-5), m)
     ver = verdicts(fp, float(sdb[-1]), max(scatter_f, 2e-5))
     outside = outside_library(fp)
-    effect, confidence, ranked = decide(scored, outside)
-    cand_out = []
-    for s in ranked:
-        c = candidate(s.name, space, m)
-        eff = {p.name: {"value": float(s.fit.theta[6 + i]), "unit": p.unit,
-                        "interval_90": _interval(s.fit, c, 6 + i)} for i, p in enumerate(c.effect_params)}
-        cand_out.append({"name": s.name, "held_out_score": s.score, "E_fit": s.fit.E,
-                         "held_out_E_per_level": s.held_out, "effect_parameters": eff,
-                         "joint_parameters": dict(zip(PARAMS, map(float, s.fit.theta[:6]))),
-                         "fingerprints_for": ver[s.name]["for"], "fingerprints_against": ver[s.name]["against"],
-                         "seconds": s.seconds})
-    # act: the named effect's model, revalidated in the time domain
+    effect, confidence, ranked = decide(scored, outside, floor=F)
+    cand_out = [_candidate_json(s, space, m, ver) for s in ranked]
+    # act: the named model, recalibrated and revalidated in the time domain
     named = next((s for s in ranked if s.name == effect), None)
     final = named if named is not None else base
     cf = candidate(final.name, space, m)
     fits = [final.fit]
     for th in joint_starts:  # the final model from the GA's other valleys too
         start = np.r_[np.asarray(th, dtype=float)[:6], final.fit.theta[6:]]
-        alt = fit_candidate(cf, runs, start, starts=1, max_nfev=2 * settings.max_nfev)
+        alt = fit_candidate(cf, runs, start, starts=1, max_nfev=2 * settings.max_nfev, refresh=1)
         say(f"{assembly}: {final.name} refit from Fs = {th[0]:.3g} lbf: E {alt.E:.2f}")
         fits.append(alt)
     rec = recalibrate(cf, runs, fits, seed=settings.seed, generations=settings.ga_generations,
                       steps=settings.posterior_steps, max_nfev=2 * settings.max_nfev)
+    lap("recalibrate")
     say(f"{assembly}: {final.name} recalibrated: GA best E {rec.ga_best_E:.2f} ({rec.ga_generations} generations), "
         f"polished E {rec.fit.E:.2f}; emcee {rec.steps} steps, tau {rec.tau_max:.0f}")
     final = type(final)(final.name, rec.fit, final.score, final.held_out, final.seconds)
@@ -193,19 +239,18 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
                                  envelopes_kw=envelopes_kw, modal_kw=modal_kw, executor=executor)
         metric_before = float(v_before.error["E"])
     metric_after = float(v_after.error["E"])
+    lap("validate_after")
+    effect, confidence, time_note = confirm(effect, confidence, float(metric_before), metric_after)
     joint_after = {p: {"value": float(final.fit.theta[i]), "interval_90": rec.interval(i)}
                    for i, p in enumerate(PARAMS)}
     diagnosis = {
-        "assembly": assembly, "effect": effect, "confidence": confidence,
-        "rule": (f"none if the baseline's held-out score <= {NONE_E} (unless the best candidate scores <= "
-                 f"{WITHIN_SCATTER} x the baseline and <= {MARGIN} x the runner-up: named, medium); else name the best candidate if it closes "
-                 f">= {CLOSE_FRACTION:.0%} of the baseline's excess over 1 and scores <= {MARGIN} x the runner-up "
-                 "(confidence high when its score <= 2); otherwise unexplained. A fingerprint no library effect "
-                 "leaves (a dominant even harmonic) keeps a name only at score <= 2, with confidence medium"),
+        "assembly": assembly, "effect": effect, "effects": list(effects_of(effect)) if effect not in (
+            "none", "unexplained") else [], "confidence": confidence, "rule": RULE,
         "outside_library": outside,
+        "fast_model_floor": floor, "time_domain_check": time_note,
         "baseline": {"held_out_score": base.score, "E_fit": base.fit.E, "held_out_E_per_level": base.held_out,
                      "joint_parameters": dict(zip(PARAMS, map(float, base.fit.theta[:6])))},
-        "candidates": cand_out, "fingerprints": fp,
+        "candidates": cand_out, "pairs_tried": pairs_tried, "fingerprints": fp,
         "metric_before": float(metric_before), "metric_after": metric_after,
         "metric_change": metric_after / metric_before - 1.0 if metric_before else None,
         "recalibrated": {"model": final.name, "joint_parameters": joint_after, "E_fit": final.fit.E,
@@ -219,47 +264,6 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
                                     + "; intervals are the 5-95% posterior quantiles"),
                          "posterior_converged": rec.converged},
         "calibration_joint_parameters": dict(zip(PARAMS, map(float, theta0))),
-        "words_after": v_after.words, "seconds": time.perf_counter() - t_start,
+        "words_after": v_after.words, "seconds": time.perf_counter() - t_start, "seconds_per_step": clock,
     }
     return {"diagnosis": diagnosis, "residuals": res, "validation_after": v_after}
-
-
-def diagnosis_markdown(d: Mapping) -> str:
-    """A short plain-language diagnosis a test engineer can act on."""
-    lines = [f"# Discrepancy diagnosis: assembly {d['assembly']}", ""]
-    E0, E1 = d["metric_before"], d["metric_after"]
-    if d["effect"] in EFFECTS:
-        c = next(c for c in d["candidates"] if c["name"] == d["effect"])
-        vals = {k: v["value"] for k, v in c["effect_parameters"].items()}
-        lines += [f"**Missing effect: `{d['effect']}`** (confidence {d['confidence']}).", "",
-                  EFFECTS[d["effect"]].advice(vals)[0].upper() + EFFECTS[d["effect"]].advice(vals)[1:] + ".", "",
-                  f"With it the validation error E (1 = the measured repeat scatter) goes from {E0:.2f} to {E1:.2f} "
-                  f"({(E1 / E0 - 1) * 100:+.0f}%), checked with the time simulation driven by each run's measured "
-                  "base record.", ""]
-        if c["fingerprints_for"]:
-            lines += ["Evidence: " + "; ".join(c["fingerprints_for"]) + ".", ""]
-        if d.get("outside_library"):
-            lines += ["But something else is there too: " + d["outside_library"] + ".", ""]
-        ep = d["recalibrated"]["effect_parameters"]
-        bounds = {p.name: (p.lo, p.hi) for p in EFFECTS[d["effect"]].params}
-        for k, v in ep.items():
-            lo, hi = v["interval_90"]
-            loose = lo <= bounds[k][0] * (1 + 1e-6) or hi >= bounds[k][1] * (1 - 1e-6)
-            lines.append(f"- {k} = {v['value']:.4g} {v['unit']}, 90% interval [{lo:.4g}, {hi:.4g}]"
-                         + (" (reaches a bound of the library's range: the data do not pin it)" if loose else ""))
-    elif d["effect"] == "none":
-        lines += [f"**No missing effect**: the calibrated model predicts levels it did not see within "
-                  f"{d['baseline']['held_out_score']:.2f}x the measured repeat scatter (E = {E0:.2f}).", ""]
-    else:
-        lines += [f"**Unexplained**: the model misses the measurement (E = {E0:.2f}, held-out score "
-                  f"{d['baseline']['held_out_score']:.2f}) and no single library effect closes the gap decisively. "
-                  "Best candidates:", ""]
-        for c in d["candidates"][:3]:
-            lines.append(f"- `{c['name']}`: held-out score {c['held_out_score']:.2f}; against it: "
-                         + ("; ".join(c["fingerprints_against"][:2]) or "nothing"))
-        lines += ["", ("What the library cannot explain: " + d["outside_library"] + "."
-                       if d.get("outside_library") else
-                       "Look for a second effect or one outside the library (e.g. a contact, a second mode).")]
-    lines += ["", "| model | held-out score |", "|---|---|", f"| baseline | {d['baseline']['held_out_score']:.2f} |"]
-    lines += [f"| {c['name']} | {c['held_out_score']:.2f} |" for c in d["candidates"]]
-    return "\n".join(lines) + "\n"

@@ -4,9 +4,11 @@ from .iwan import IwanParams, backbone, backbone_stiffness, derived, dissipation
 from .simulate import SimResult, fractional_delay, simulate
 from .structure import Fixture, MinistackModel, state_space
 from .envelope import SteadyState, steady_state
+from .swept import SweepDrive, quasi_steady, swept_transmissibility
 
 __all__ = [
     "G", "IwanParams", "derived", "backbone", "backbone_stiffness", "dissipation", "force_history",
     "qsma", "harmonic_balance", "jenkins_inphase", "resonance_amplitude",
-    "MinistackModel", "Fixture", "SteadyState", "steady_state", "state_space", "simulate", "SimResult", "fractional_delay",
+    "MinistackModel", "Fixture", "SteadyState", "steady_state", "SweepDrive", "quasi_steady", "swept_transmissibility",
+    "state_space", "simulate", "SimResult", "fractional_delay",
 ]

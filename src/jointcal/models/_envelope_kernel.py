@@ -12,6 +12,10 @@ mu = m omega^2, B = m A; a flexible fixture: see `envelope._structure_terms`). S
 branches have dr/ds > 0. The kernel marches over the frequencies in sweep order and
 continues the branch of the previous frequency by a bracketed Newton iteration; when
 the branch ends at a fold the iteration lands on the other branch, which is flagged.
+
+The same K_z carries the sweep's transient (`jointcal.models.swept`): `stiffness_slopes`
+gives its derivatives at a solution, `slow_flow` integrates the averaged (slow-flow)
+equation of the joint DOF in a frame rotating with the drive.
 """
 from __future__ import annotations
 
@@ -223,3 +227,64 @@ def rigid_output(kre, kim, mu, mA, w, A, gain, tau, Z_out, T_out):
             if tau[p] != 0.0:
                 t *= np.exp(complex(0.0, -w[n] * tau[p]))
             T_out[p, n] = t
+
+
+@njit(cache=True)
+def stiffness_slopes(q, w, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights, out):
+    """K_z and its slopes at amplitudes q (P, N), omega w (N,); parameter arrays (P,).
+
+    Writes out (5, P, N): Re K_z, Im K_z, dRe/dlog q, dIm/dlog q (lbf/in) and dIm/domega
+    at fixed q (lbf s/in: the dashpot c and the quadratic damper's 16 c2 omega q / (3 pi)).
+    """
+    P, N = q.shape
+    for p in range(P):
+        for n in range(N):
+            qq = max(q[p, n], 1e-300)
+            re, im, dre, dim = _stiffness(qq, np.log(qq), w[n], kp[p], c[p], KT[p], R[p], chi[p], phimax[p], S[p],
+                                          J1[p], k3[p], c2[p], nodes, weights)
+            out[0, p, n] = re
+            out[1, p, n] = im
+            out[2, p, n] = dre
+            out[3, p, n] = dim
+            out[4, p, n] = c[p] + 16.0 * c2[p] * w[n] * qq / (3.0 * PI)
+
+
+@njit(cache=True, inline="always")
+def _flow(z, w, al, p0, g0, m1, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights):
+    """Z' of the slow flow (m1 + C) Z' = g0 - (K_z(|Z|, w) + p0 + alpha C' / 2) Z, and the joint force.
+
+    C = dIm K_z / domega (dashpot, quadratic damper) turns the envelope's rate into force,
+    C' = dC/domega its sweep term; the joint force is (K_z + alpha C' / 2) Z + C Z'.
+    """
+    q = max(abs(z), 1e-300)
+    re, im, dre, dim = _stiffness(q, np.log(q), w, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights)
+    C = c + 16.0 * c2 * w * q / (3.0 * PI)
+    kz = complex(re, im) + 0.5 * al * 16.0 * c2 * q / (3.0 * PI)
+    zdot = (g0 - (kz + p0) * z) / (m1 + C)
+    return zdot, kz * z + C * zdot
+
+
+@njit(cache=True)
+def slow_flow(z0, h, w, al, p0, g0, m1, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights, force_out):
+    """RK4 of the slow flow (`_flow`) from Z(0) = z0 for one parameter set.
+
+    Nodes t_j = j h, j = 0 .. n-1; omega w, alpha al and the coefficients p0, g0, m1 are given
+    at half steps, shape (2n - 1,) (index 2j at node j). Writes the joint force at the nodes
+    into force_out (n,).
+    """
+    n = force_out.shape[0]
+    z = z0
+    for j in range(n):
+        i = 2 * j
+        k1, force = _flow(z, w[i], al[i], p0[i], g0[i], m1[i], kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes,
+                          weights)
+        force_out[j] = force
+        if j == n - 1:
+            break
+        k2, _ = _flow(z + 0.5 * h * k1, w[i + 1], al[i + 1], p0[i + 1], g0[i + 1], m1[i + 1], kp, c, KT, R, chi,
+                      phimax, S, J1, k3, c2, nodes, weights)
+        k3_, _ = _flow(z + 0.5 * h * k2, w[i + 1], al[i + 1], p0[i + 1], g0[i + 1], m1[i + 1], kp, c, KT, R, chi,
+                       phimax, S, J1, k3, c2, nodes, weights)
+        k4, _ = _flow(z + h * k3_, w[i + 2], al[i + 2], p0[i + 2], g0[i + 2], m1[i + 2], kp, c, KT, R, chi,
+                      phimax, S, J1, k3, c2, nodes, weights)
+        z = z + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3_ + k4)

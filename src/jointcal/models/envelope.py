@@ -75,6 +75,72 @@ def _field(value, shape) -> NDArray[np.float64]:
     return np.ascontiguousarray(a.reshape(-1, shape[-1])[:, 0])
 
 
+def _batch_shape(model: MinistackModel, f_shape: tuple) -> tuple[tuple[int, int], tuple]:
+    """(P, N) of a model's parameter batch along frequencies of shape f_shape, and the broadcast output shape."""
+    iw = model.iwan
+    fields = [model.m, model.k, model.zeta_v, model.k3, model.c2, model.sensor_gain, model.sensor_delay_s]
+    if iw is not None:
+        fields += [iw.Fs, iw.KT, iw.chi, iw.beta]
+    if model.fixture is not None:
+        fields += [model.fixture.m_can, model.fixture.f_can, model.fixture.zeta_can]
+    out_shape = np.broadcast_shapes(*(np.shape(v) for v in fields), f_shape)
+    return (int(np.prod(out_shape[:-1], dtype=int)), out_shape[-1]), out_shape
+
+
+def _joint_terms(model: MinistackModel, shape) -> tuple[NDArray, ...]:
+    """The joint DOF's kernel parameters, each (P,): k, c, KT, R, chi, phi_max, S, J(chi, 1), k3, c2.
+
+    c = 2 zeta_v sqrt((k + KT) m) is the dashpot (lbf s/in); R, S, phi_max the Iwan density
+    parameters (`iwan.derived`); a linear model has KT = 0.
+    """
+    P = shape[0]
+    m, k, zv = (_field(v, shape) for v in (model.m, model.k, model.zeta_v))
+    k3, c2 = _field(model.k3, shape), _field(model.c2, shape)
+    iw = model.iwan
+    if iw is None:
+        KT = np.zeros(P)
+        R = S = J1 = np.zeros(P)
+        chi = np.full(P, -0.5)
+        phimax = np.ones(P)
+    else:
+        Fs, KT, chi, beta = (_field(v, shape) for v in (iw.Fs, iw.KT, iw.chi, iw.beta))
+        phimax, R, S = derived(Fs, KT, chi, beta)
+        J1 = _J(chi, np.ones_like(chi))
+    c = 2.0 * zv * np.sqrt((k + KT) * m)
+    return k, c, KT, R, chi, phimax, S, J1, k3, c2
+
+
+def _amplitudes(f: NDArray, A: NDArray, direction: str, shape, joint, m: NDArray, mu: NDArray,
+                gamma: NDArray | None) -> tuple[NDArray, ...]:
+    """The kernel's continuation along the sweep: s = log q, jump flags and K_z = kre + i kim, each (P, N).
+
+    joint : `_joint_terms`; m (P,); mu (P, N) and gamma (P, N) or None (rigid base) from
+    `_structure_terms`; A (N,) base amplitude, in/s^2.
+    """
+    P = shape[0]
+    w = 2 * np.pi * f
+    k, c, KT, R, chi, phimax, S, J1, k3, c2 = joint
+    rigid = gamma is None
+    logB = np.log(m[:, None] * A) + (0.0 if rigid else np.log(np.abs(gamma)))
+    order = np.argsort(f, kind="stable")
+    if direction == "down":
+        order = order[::-1]
+    n0 = order[0]
+    stuck = k + KT + 1j * w[n0] * c
+    g0 = 1.0 if rigid else np.abs(gamma[:, n0])
+    s0 = np.log(g0 * m * A[n0] / np.abs(stuck - mu[:, n0]))
+    s = np.empty((P, f.size))
+    jump = np.zeros((P, f.size), dtype=np.bool_)
+    kre, kim = np.empty((P, f.size)), np.empty((P, f.size))
+    solver = _k.solve_parallel if P >= 64 else _k.solve  # threads pay off only for large batches
+    mu_re = np.ascontiguousarray(mu.real)
+    mu_im = np.zeros_like(mu_re) if rigid else np.ascontiguousarray(mu.imag)
+    solver(w, mu_re, mu_im, np.ascontiguousarray(np.broadcast_to(logB, (P, f.size))), s0,
+           order.astype(np.int64), k, c, KT, R, chi, phimax, S, J1, k3, c2, _NODES, _WEIGHTS, TOL, s, jump,
+           kre, kim)
+    return s, jump, kre, kim
+
+
 def _structure_terms(model: MinistackModel, w: NDArray, shape) -> tuple[NDArray, NDArray]:
     """Effective inertia mu (P, N) and base-load factor gamma (P, N) seen by the joint DOF.
 
@@ -137,48 +203,14 @@ def steady_state(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike = 1.0
     if np.any(np.asarray(model.contact_k) != 0):
         raise ValueError("steady_state has no first-harmonic model of a unilateral contact (contact_k > 0): its "
                          "response has a mean offset and even harmonics; use jointcal.models.simulate.")
-    iw = model.iwan
-    fields = [model.m, model.k, model.zeta_v, model.k3, model.c2, model.sensor_gain, model.sensor_delay_s]
-    if iw is not None:
-        fields += [iw.Fs, iw.KT, iw.chi, iw.beta]
-    if model.fixture is not None:
-        fields += [model.fixture.m_can, model.fixture.f_can, model.fixture.zeta_can]
-    shape = np.broadcast_shapes(*(np.shape(v) for v in fields), f.shape)
-    out_shape = shape
-    shape = (int(np.prod(shape[:-1], dtype=int)), shape[-1])
+    shape, out_shape = _batch_shape(model, f.shape)
     P = shape[0]
     w = 2 * np.pi * f
-    m, k, zv = (_field(v, shape) for v in (model.m, model.k, model.zeta_v))
-    k3, c2 = _field(model.k3, shape), _field(model.c2, shape)
-    if iw is None:
-        KT = np.zeros(P)
-        R = S = J1 = np.zeros(P)
-        chi = np.full(P, -0.5)
-        phimax = np.ones(P)
-    else:
-        Fs, KT, chi, beta = (_field(v, shape) for v in (iw.Fs, iw.KT, iw.chi, iw.beta))
-        phimax, R, S = derived(Fs, KT, chi, beta)
-        J1 = _J(chi, np.ones_like(chi))
-    c = 2.0 * zv * np.sqrt((k + KT) * m)
+    m = _field(model.m, shape)
     mu, gamma = _structure_terms(model, w, shape)
     rigid = model.fixture is None  # gamma = 1, mu real: skip the complex work
-    logB = np.log(m[:, None] * A) + (0.0 if rigid else np.log(np.abs(gamma)))
-    order = np.argsort(f, kind="stable")
-    if direction == "down":
-        order = order[::-1]
-    n0 = order[0]
-    stuck = k + KT + 1j * w[n0] * c
-    g0 = 1.0 if rigid else np.abs(gamma[:, n0])
-    s0 = np.log(g0 * m * A[n0] / np.abs(stuck - mu[:, n0]))
-    s = np.empty((P, f.size))
-    jump = np.zeros((P, f.size), dtype=np.bool_)
-    kre, kim = np.empty((P, f.size)), np.empty((P, f.size))
-    solver = _k.solve_parallel if P >= 64 else _k.solve  # threads pay off only for large batches
+    s, jump, kre, kim = _amplitudes(f, A, direction, shape, _joint_terms(model, shape), m, mu, gamma)
     mu_re = np.ascontiguousarray(mu.real)
-    mu_im = np.zeros_like(mu_re) if rigid else np.ascontiguousarray(mu.imag)
-    solver(w, mu_re, mu_im, np.ascontiguousarray(np.broadcast_to(logB, (P, f.size))), s0,
-             order.astype(np.int64), k, c, KT, R, chi, phimax, S, J1, k3, c2, _NODES, _WEIGHTS, TOL, s, jump,
-             kre, kim)
     q = np.exp(s)
     gain = _field(model.sensor_gain, shape)
     tau = _field(model.sensor_delay_s, shape)
