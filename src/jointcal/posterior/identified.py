@@ -39,7 +39,7 @@ from ..calibrate.space import PARAMS, ParamSpace
 from ..models import derived, dissipation
 
 __all__ = ["Quantity", "quantities", "unit_jacobian", "fisher", "free_share", "fixed_directions",
-           "identified_table", "PRIOR_PRECISION"]
+           "identified_table", "identified_at", "PRIOR_PRECISION"]
 
 PRIOR_PRECISION = 12.0  # 1 / variance of a uniform distribution on [0, 1]
 Z90 = 3.2897  # width of a normal 90% interval in standard deviations
@@ -287,3 +287,46 @@ def identified_table(samples: ArrayLike, names: Sequence[str], space: ParamSpace
                          prior_hi=space.hi[i] if i is not None else np.nan, free_share=med,
                          identified=bool(med < 0.5), fixed_directions=n_fixed))
     return pd.DataFrame(rows), info
+
+
+def identified_at(theta: ArrayLike, sigma: ArrayLike, q: ArrayLike, space: ParamSpace, *, m: float,
+                  model: str = "harmonic_balance", viscous: str = "dashpot",
+                  ratio: float = 0.5) -> dict[str, bool]:
+    """Which parameters read-outs at amplitudes `q` would identify at one parameter point.
+
+    For a model known only by a point and per-parameter intervals (the discrepancy stage's
+    recalibration): the read-outs are the model's own frequency and damping at `q` with
+    relative noise `sigma` (e.g. the measured repeat scatter), and the free directions'
+    extent is the prior's (covariance I / 12 in the unit cube) for want of draws.
+
+    Parameters
+    ----------
+    theta : array_like, shape (6,)
+        (Fs, KT, chi, beta, k, zeta_v), physical units.
+    sigma : array_like, shape (2,)
+        Relative noise of frequency and damping.
+    q : array_like, shape (N,)
+        Amplitudes of the read-outs, in.
+    space : ParamSpace
+    m : float
+        Mass, lbf s^2/in.
+    model, viscous : str
+    ratio : float
+        As `identified_table`.
+
+    Returns
+    -------
+    dict
+        parameter -> identified.
+    """
+    th = np.atleast_2d(np.asarray(theta, dtype=float))
+    q = np.asarray(q, dtype=float)
+    with np.errstate(all="ignore"):
+        f, z = predict(th, q, m=m, model=model, viscous=viscous)  # type: ignore[arg-type]
+    info = fisher(th, np.atleast_2d(sigma), q, f[0], z[0], space, m=m, model=model, viscous=viscous)
+    cov = np.eye(th.shape[1]) / PRIOR_PRECISION
+    out = {}
+    for i, p in enumerate(PARAMS):
+        share = free_share(np.eye(th.shape[1])[i][None], info, cov, ratio=ratio)
+        out[p] = bool(share[0] < 0.5)
+    return out
