@@ -69,10 +69,12 @@ def evaluate(cands: pd.DataFrame, samples: NDArray[np.float64], names: Sequence[
     -------
     table : DataFrame
         One row per candidate (the columns of `cands`, then the read-out quantiles f_q05,
-        f_q50, f_q95 (Hz), zeta_q05/q50/q95, q_q50 (in), peak_g_q50, peak_g_q95, eta_q95,
-        admissible, reached, macroslip, spread_f_over_scatter, eig_nats, share_targets, and
-        per quantity ratio_<name>, ratio_if_identified_<name>, ratio_if_not_<name>,
-        share_identified_<name>).
+        f_q50, f_q95 (Hz), zeta_q05/q50/q95, q_q50 (in), peak_g_q50, peak_g_q95 (g), reached
+        (share of draws whose sweep passes quadrature), macroslip (share past phi_max),
+        spread_f_over_scatter, eta_q95, valid (share of draws with a quasi-steady read-out at
+        this rate), eig_nats, share_targets, per quantity ratio_<name>, ratio_if_identified_<name>,
+        ratio_if_not_<name>, share_identified_<name>, per depth bin share_depth_<bin> and, for
+        the targets, ratio_depth_<bin>_<name>; `jointcal.design.narrowing`).
     per_quantity : DataFrame
         The narrowing rows of every candidate (level_g, direction, sweep_rate_hz_per_s, quantity, ...).
     """
@@ -123,9 +125,12 @@ def evaluate(cands: pd.DataFrame, samples: NDArray[np.float64], names: Sequence[
             row = {**c._asdict(), **base, "eta_q95": float(np.nanpercentile(np.where(ok, eta, np.nan), 95))
                    if ok.any() else np.nan, "valid": float(valid.mean()), "eig_nats": summ["eig_nats"],
                    "share_targets": summ["share_targets"]}
-            for t in table.itertuples():
-                row.update({f"ratio_{t.quantity}": t.ratio, f"ratio_if_identified_{t.quantity}": t.ratio_if_identified,
-                            f"ratio_if_not_{t.quantity}": t.ratio_if_not,
-                            f"share_identified_{t.quantity}": t.share_identified})
+            for _, t in table.iterrows():
+                n = t["quantity"]
+                row.update({f"ratio_{n}": t["ratio"], f"ratio_if_identified_{n}": t["ratio_if_identified"],
+                            f"ratio_if_not_{n}": t["ratio_if_not"], f"share_identified_{n}": t["share_identified"]})
+                if n in targets:  # the narrowing by how far past macroslip the test goes
+                    row.update({f"{c}_{n}": t[c] for c in t.index if c.startswith("ratio_depth_")})
+            row.update({c: table[c].iloc[0] for c in table.columns if c.startswith("share_depth_")})
             rows.append(row)
     return pd.DataFrame(rows), pd.concat(per_q, ignore_index=True)

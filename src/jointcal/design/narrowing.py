@@ -22,9 +22,13 @@ information gain (EIG) that goes with it:
 * EIG_j = 1/2 log det(I + A_j^-1 N_j) (nats; Laplace approximation).
 
 Over the draws: the expected narrowing is the geometric mean of the ratios; the share of
-draws the test identifies g at; and the narrowing conditional on either outcome
-(identified or not), since the new run itself shows which one happened (in microslip its
-frequency and damping follow the power law of the runs in hand; past macroslip they do not).
+draws the test identifies g at; the narrowing conditional on either outcome (identified or
+not), since the new run itself shows which one happened (in microslip its frequency and
+damping follow the power law of the runs in hand; past macroslip they do not); and the
+narrowing as a function of how far past the macroslip onset the test goes (`DEPTHS`: the
+amplitude reached over phi_max, eq. 3.7), which the test reveals too: past macroslip the
+recalibrated posterior identifies phi_max. The further past it, the larger the narrowing,
+so a prediction for that depth is the one to hold the outcome against.
 """
 from __future__ import annotations
 
@@ -35,9 +39,20 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from ..calibrate.space import ParamSpace
+from ..models import derived
 from ..posterior.identified import PRIOR_PRECISION, Z90, fisher, free_share
 
-__all__ = ["CRITERION", "narrowing"]
+__all__ = ["CRITERION", "DEPTHS", "depth_labels", "narrowing"]
+
+DEPTHS = (0.0, 1.0, 1.2, 1.5, 2.0, 3.0, np.inf)  # bins of q reached / phi_max
+
+
+def depth_labels() -> list[str]:
+    """Labels of the `DEPTHS` bins, e.g. '<1', '1.2-1.5', '>3'."""
+    out = []
+    for lo, hi in zip(DEPTHS[:-1], DEPTHS[1:]):
+        out.append(f"<{hi:g}" if lo == 0 else f">{lo:g}" if not np.isfinite(hi) else f"{lo:g}-{hi:g}")
+    return out
 
 CRITERION = ("predicted narrowing of the 90% intervals (now over after) and expected information gain, from a "
              "local Laplace approximation at each posterior draw taken as the truth: the Fisher information of the "
@@ -89,7 +104,9 @@ def narrowing(theta: NDArray[np.float64], sigma: NDArray[np.float64], info: NDAr
         One row per quantity: quantity, width_now, ratio (geometric mean over the draws),
         width_after (width_now / ratio), share_identified (share of draws at which it is
         identified after the test), ratio_if_identified, ratio_if_not (geometric means over
-        the draws at which the test identifies it and the others; NaN if none).
+        the draws at which the test identifies it and the others; NaN if none), and per depth
+        bin b of `depth_labels` (q reached over phi_max; draws without a read-out count as
+        below 1) share_depth_<b> and ratio_depth_<b> (geometric mean; NaN for an empty bin).
     summary : dict
         eig_nats (mean EIG), reached (share of draws whose sweep passes quadrature),
         share_targets (share of draws at which every target is identified after the test).
@@ -109,6 +126,10 @@ def narrowing(theta: NDArray[np.float64], sigma: NDArray[np.float64], info: NDAr
         r = np.where(ident, s0 / s1, np.minimum(w, Z90 * s0) / np.minimum(w, Z90 * s1))
     r = np.where(np.isfinite(r) & (r > 0), np.maximum(r, 1.0), 1.0)
     lr = np.log(r)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        depth = np.where(ok, read["q_in"].to_numpy(float) / derived(*theta[:, :4].T)[0], 0.0)
+    bins = np.digitize(depth, DEPTHS[1:-1])
+    labels = depth_labels()
     rows = []
     all_hit = np.ones(P, bool)
     for i, name in enumerate(names):
@@ -120,7 +141,10 @@ def narrowing(theta: NDArray[np.float64], sigma: NDArray[np.float64], info: NDAr
         rows.append(dict(quantity=name, width_now=float(w[0, i]), ratio=gm, width_after=float(w[0, i]) / gm,
                          share_identified=float(np.mean(after)),
                          ratio_if_identified=float(np.exp(np.mean(lr[hit, i]))) if hit.any() else np.nan,
-                         ratio_if_not=float(np.exp(np.mean(lr[~hit, i]))) if (~hit).any() else np.nan))
+                         ratio_if_not=float(np.exp(np.mean(lr[~hit, i]))) if (~hit).any() else np.nan,
+                         **{f"share_depth_{b}": float(np.mean(bins == k)) for k, b in enumerate(labels)},
+                         **{f"ratio_depth_{b}": float(np.exp(np.mean(lr[bins == k, i]))) if (bins == k).any()
+                            else np.nan for k, b in enumerate(labels)}))
     ld0, ld1 = np.linalg.slogdet(A0)[1], np.linalg.slogdet(A1)[1]
     return pd.DataFrame(rows), {"eig_nats": float(np.mean(0.5 * (ld1 - ld0))), "reached": float(np.mean(ok)),
                                 "share_targets": float(np.mean(all_hit)) if targets else float("nan")}

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .narrowing import CRITERION
+from .narrowing import CRITERION, depth_labels
 
 __all__ = ["RULE", "rank", "recommendation", "next_test_markdown"]
 
@@ -88,6 +88,11 @@ def recommendation(ranked: pd.DataFrame, per_quantity: pd.DataFrame, *, targets:
         "width_now": {n: float(pq.loc[n, "width_now"]) for n in reported},
         "width_after": {n: float(pq.loc[n, "width_after"]) for n in reported},
         "width_units": "decades (log10) for Fs, KT, beta, k, zeta_v, K0, KT/k; linear for chi",
+        "predicted_width_ratio_by_depth": {
+            "depth": "amplitude the test reaches over the macroslip onset phi_max (eq. 3.7), per posterior draw",
+            "bins": depth_labels(),
+            "share_of_draws": [float(pq[f"share_depth_{b}"].iloc[0]) for b in depth_labels()],
+            **{n: [float(pq.loc[n, f"ratio_depth_{b}"]) for b in depth_labels()] for n in reported}},
         "predicted_readout": {"f_hz": [float(best["f_q05"]), float(best["f_q50"]), float(best["f_q95"])],
                               "zeta": [float(best["zeta_q05"]), float(best["zeta_q50"]), float(best["zeta_q95"])],
                               "q_in_median": float(best["q_q50"]), "peak_response_g": [float(best["peak_g_q50"]),
@@ -141,6 +146,15 @@ def next_test_markdown(rec: Mapping[str, Any], ranked: pd.DataFrame, *, words_no
             lines.append(f"- {n}: now known within {_factor(wn[n])}; if the test identifies it, within "
                          f"{_factor(w1)} (width ratio {_g(ri[n])}); if not, ratio {_g(rn[n])}; expected over the "
                          f"draws {_g(rec['predicted_width_ratio'][n])}.")
+        bd = rec["predicted_width_ratio_by_depth"]
+        lines += ["", "The further past macroslip the test goes, the more it narrows (the recalibrated posterior will "
+                  "show where phi_max lies, so hold the outcome against its row):", "",
+                  "| amplitude reached / phi_max | share of draws | " + " | ".join(f"{n} ratio" for n in tg) + " |",
+                  "|---|---|" + "---|" * len(tg)]
+        for k, b in enumerate(bd["bins"]):
+            if bd["share_of_draws"][k] > 0:
+                lines.append(f"| {b} | {100 * bd['share_of_draws'][k]:.0f}% | "
+                             + " | ".join(_g(bd[n][k]) for n in tg) + " |")
     lines += ["", "Expected width ratios (now over after, 90% intervals in the sampling space): "
               + ", ".join(f"{n} {_g(v)}" for n, v in rec["predicted_width_ratio"].items()) + ".",
               f"Expected information gain {rec['expected_information_gain_nats']:.2f} nats.", "",

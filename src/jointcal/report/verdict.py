@@ -72,7 +72,7 @@ def _unit(row: pd.Series) -> str:
 
 def _item1(best: Mapping, validation: Mapping | None, fit: Mapping | None) -> str:
     kind = "the paper's model" if best.get("model_kind", "ministack") == "ministack" else "the calibrated mode"
-    parts = []
+    parts = [] if validation is not None else ["The validation stage did not run."]
     if validation is not None:
         E = float(validation["E"])
         holds = E <= HOLDS_E
@@ -84,7 +84,7 @@ def _item1(best: Mapping, validation: Mapping | None, fit: Mapping | None) -> st
         parts.append(f"Its calibrated frequencies and damping ratios {'are rejected by' if reject else 'agree with'} "
                      f"the repeats: chi-square {_g(float(fit['fit_chi2']))} for {int(fit['fit_dof'])} degrees of "
                      f"freedom, p = {p:.1g}{' (the model, not noise, sets the misfit)' if reject else ''}.")
-    return " ".join(parts) or "The validation stage did not run."
+    return " ".join(parts)
 
 
 def _item2(diagnosis: Mapping | None, best: Mapping) -> str:
