@@ -64,6 +64,7 @@ rule posterior_report:
         curves=expand(RESULTS / "calibration" / "{assembly}" / "model_curves.csv", assembly=ASSEMBLIES),
         summary=expand(POSTERIOR / "{assembly}" / "summary.csv", assembly=ASSEMBLIES),
         predictive=expand(POSTERIOR / "{assembly}" / "predictive.csv", assembly=ASSEMBLIES),
+        identified=expand(POSTERIOR / "{assembly}" / "identified.csv", assembly=ASSEMBLIES),
     output:
         figure=report(RESULTS / "figures" / "fig3_8_amplitude_fit.png", caption="../report/fig3_8_amplitude_fit.rst",
                       category="3. Posterior"),
