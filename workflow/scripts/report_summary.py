@@ -16,7 +16,7 @@ from jointcal.io import write_bytes_atomic
 from jointcal.posterior import NAMES, PosteriorSettings, find_modes
 from jointcal.report.summary import bound_hits, chain_status, ga_best_point, landing_html, summary_html, table_3_2_html
 from jointcal.posterior.identified import identified_at
-from jointcal.report.verdict import corrected_holds, identified_html, landing_verdict, verdict_html, verdict_items
+from jointcal.report.verdict import corrected_holds, identified_html, verdict_html, verdict_items
 
 
 def _json(files, names):
@@ -96,7 +96,7 @@ def main(smk) -> None:
         if hits:
             n.append("optimum at a bound: " + ", ".join(f"{p} ({side})" for p, side in hits.items()))
         notes[a] = n
-    landing = landing_html(runs=runs, modal=modal, status=status, notes=notes, verdict=landing_verdict(items))
+    landing = landing_html(runs=runs, modal=modal, status=status, notes=notes, verdict=verdict_html(items, landing=True))
     write_bytes_atomic(landing.encode(), smk.output.landing)
     write_bytes_atomic(table_html.encode(), smk.output.table)
     Path(smk.log[0]).write_text("".join(f"jointcal: {a}: {line}\n" for a, (_, line) in status.items()))

@@ -28,21 +28,13 @@ import pandas as pd
 from ..calibrate.space import PARAMS
 from ..posterior.stage import P_REJECT
 from ..validate.error import closeness
+from .summary import fmt as _g
 
-__all__ = ["HOLDS_E", "named_effects", "corrected_holds", "verdict_items", "identified_html", "verdict_html", "landing_verdict"]
+__all__ = ["HOLDS_E", "named_effects", "corrected_holds", "verdict_items", "identified_html", "verdict_html"]
 
 HOLDS_E = 2.0  # a model holds when its E is "about as close as a repeated test" (closeness)
 _WORDS = {"K0": "K0 = k + KT", "R": "R (eq. 3.5)", "D_ref": "dissipation per cycle at q_ref",
           "dissipation_exponent": "dissipation exponent chi + 3", "KT/k": "KT/k split", "phi_max": "phi_max (eq. 3.7)"}
-
-
-def _g(v: float) -> str:
-    if v is None or not np.isfinite(v):
-        return "-"
-    if v == 0 or 1e-3 <= abs(v) < 1e4:
-        return f"{v:.4g}" if abs(v) >= 1 else f"{v:.3g}"
-    mant, exp = f"{v:.3e}".split("e")
-    return f"{float(mant):.3g}e{int(exp)}"
 
 
 def _interval(lo: float, hi: float, unit: str = "") -> str:
@@ -209,22 +201,14 @@ def identified_html(identified: pd.DataFrame, *, title: str) -> str:
     return "\n".join(rows)
 
 
-def verdict_html(items: Mapping[str, Sequence[tuple[str, str]]]) -> str:
-    """The summary page's opening: per assembly the four items, numbered."""
-    out = ["<h3>Verdict of this run</h3>"]
+def verdict_html(items: Mapping[str, Sequence[tuple[str, str]]], *, landing: bool = False) -> str:
+    """Per assembly the four items, numbered: the summary page's opening (with the questions) or, with
+    ``landing``, the landing text's (answers only, left-aligned in Snakemake's centred landing page)."""
+    out = (['<div style="font-size:13px;line-height:1.35;text-align:left">'] if landing
+           else ["<h3>Verdict of this run</h3>"])
     for name, its in items.items():
-        out.append(f"<p><b>Assembly {html.escape(name)}</b></p><ol class='verdict'>")
-        out += [f"<li><b>{html.escape(q)}</b> {a}</li>" for q, a in its]
+        out.append(f"<div><b>{html.escape(name)}</b></div><ol style='margin-top:0'>" if landing
+                   else f"<p><b>Assembly {html.escape(name)}</b></p><ol class='verdict'>")
+        out += [f"<li>{a}</li>" if landing else f"<li><b>{html.escape(q)}</b> {a}</li>" for q, a in its]
         out.append("</ol>")
-    return "\n".join(out)
-
-
-def landing_verdict(items: Mapping[str, Sequence[tuple[str, str]]]) -> str:
-    """The landing page's opening: the same items, one short block per assembly."""
-    out = ['<div style="font-size:13px;line-height:1.35;text-align:left">']
-    for name, its in items.items():
-        out.append(f"<div><b>{html.escape(name)}</b></div><ol style='margin-top:0'>")
-        out += [f"<li>{a}</li>" for _, a in its]
-        out.append("</ol>")
-    out.append("</div>")
-    return "\n".join(out) + "\n"
+    return "\n".join(out + (["</div>"] if landing else [])) + "\n"
