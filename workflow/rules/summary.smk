@@ -1,30 +1,8 @@
 # The report's opening summary: the verdict of the whole run (validation E, the discrepancy stage's named
 # effect and what it changed, the identified quantities of the model that holds, the next test), then
 # Table 3.2 and the details (jointcal.report.verdict, jointcal.report.summary). Include last: it reads
-# the outputs of every stage the workflow has (a workflow of the calibration and posterior stages alone
-# gets a summary of those).
-
-
-def _has_rule(name):
-    from snakemake.exceptions import WorkflowError
-
-    try:
-        getattr(rules, name)
-    except (WorkflowError, AttributeError):
-        return False
-    return True
-
-
-def verdict_inputs(wildcards):
-    """The later stages' outputs the verdict reads, for the stages this workflow has."""
-    out = {}
-    if _has_rule("validate_assembly"):
-        out["validation"] = [str(RESULTS / "validation" / a / "summary.json") for a in ASSEMBLIES]
-    if _has_rule("discrepancy_assembly") and EXCITATION == "base":
-        out["diagnosis"] = [str(RESULTS / "discrepancy" / a / "diagnosis.json") for a in ASSEMBLIES]
-    if _has_rule("design_assembly"):
-        out["design"] = [str(RESULTS / "design" / a / "next_test.json") for a in ASSEMBLIES]
-    return out
+# the outputs of every stage the workflow has (common.smk's verdict_inputs; a workflow of the calibration
+# and posterior stages alone gets a summary of those).
 
 
 rule report_summary:
