@@ -6,6 +6,9 @@
 #   calibrate  GA (DEAP) on eq. 3.9 per assembly + polish     -> <results>/calibration/<assembly>/ga_best.json
 #   posterior  emcee around the optimum, Table 3.2, Fig. 3.8  -> <results>/posterior/<assembly>/summary.csv
 #   validate   model driven by the measured base, Fig. 3.11   -> <results>/validation/<assembly>/summary.json
+#   discrepancy  the missing effect named, E before and after -> <results>/discrepancy/<assembly>/diagnosis.json
+#   design     the next test, predicted from the posterior     -> <results>/design/<assembly>/next_test.json
+#   summary    the report's opening verdict                    -> <results>/report/summary.html
 #
 # Everything:      snakemake --cores 2      (a bare `snakemake` uses profiles/default/)
 # One stage:       snakemake --cores 2 ingest
@@ -33,6 +36,8 @@ include: "workflow/rules/calibrate.smk"
 include: "workflow/rules/posterior.smk"
 include: "workflow/rules/validate.smk"
 include: "workflow/rules/discrepancy.smk"
+include: "workflow/rules/design.smk"
+include: "workflow/rules/summary.smk"  # last: reads every stage's outputs
 
 
 rule all:
@@ -44,3 +49,5 @@ rule all:
         rules.posterior.input,
         rules.validate.input,
         rules.discrepancy.input,
+        rules.design.input,
+        rules.summary.input,

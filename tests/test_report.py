@@ -1,4 +1,5 @@
-"""Report pieces: mode detection with a known answer, chain status lines, Table 3.2 in HTML, stamped figures."""
+"""Report pieces: mode detection with a known answer, chain status lines, Table 3.2 in HTML, the verdict, stamped
+figures."""
 from __future__ import annotations
 
 import numpy as np
@@ -10,6 +11,7 @@ from jointcal.posterior import find_modes, mode_labels, modes_text
 from jointcal.report.calibration import corner_figure, exploration_figure
 from jointcal.report.modal import steady_frames
 from jointcal.report.summary import bound_hits, chain_status, ga_best_point, landing_html, table_3_2_html
+from jointcal.report.verdict import named_effects, verdict_html, verdict_items
 
 BOUNDS = CalibrateSettings().full_bounds  # the Ministack kind's defaults
 
@@ -70,23 +72,33 @@ def _table(zeta_v=1e-4):
     return pd.DataFrame(rows)
 
 
-def test_table_3_2_html_marks_bounds_unconstrained_parameters_and_modes():
+def test_table_3_2_html_gives_no_value_the_posterior_does_not_support():
     history = pd.DataFrame({"generation": [0, 1], "objective": [3.0, 2.0], "Fs": [10.0, 42.1], "KT": [1e5, 4.6e5],
                             "chi": [-0.5, -0.59], "beta": [0.1, 0.0013], "k": [1e5, 9.97e5], "zeta_v": [0.01, 0.0019]})
     ga = ga_best_point(history)
     assert ga["Fs"] == 42.1 and ga["objective"] == 2.0
     modes = pd.DataFrame([dict(mode=k, weight=w, param=p, median=m, q05=m, q95=m) for k, (w, m) in
                           enumerate([(0.87, 1561.0), (0.13, 37.3)]) for p in PARAMS])
-    html = table_3_2_html(_table(), {"first": ga}, {"first": modes}, BOUNDS)
-    assert html.count("<tr>") == 1 + 5  # header, GA best, polished, posterior, two modes
-    assert "42.1" in html and "1e-4 (lower bound)" in html and "class=\"bound\"" in html
-    assert "0.135 [0.0675, 0.27]*" in html  # beta unconstrained
+    identified = pd.DataFrame({"quantity": PARAMS, "identified": [False, True, True, False, False, True]})
+    html = table_3_2_html(_table(), {"first": ga}, {"first": modes}, BOUNDS, identified={"first": identified})
+    assert html.count("<tr>") == 1 + 5  # header, posterior, two modes, polished optimum, GA best
+    assert html.count("not identified") == 3  # Fs, beta, k: in the posterior row, and no value in any other
+    for value in ("36.6", "42.1", "0.135", "0.0013", "9.97e5", "1e6"):  # Fs, beta, k values, in no row
+        assert f">{value}<" not in html and f">{value} " not in html, value
+    assert "5.1e5<br><small>[2.55e5, 1.02e6]</small>" in html  # KT identified: median and 90% interval
+    assert "spans 18.3 to 73.2 (bounds)" in html  # the range the bounds leave Fs, not a value
+    # the GA's points as members: the GA best's chi -0.59 and zeta_v 0.0019 lie outside their intervals, its KT
+    # 4.6e5 inside; the polished optimum sits at the medians here
+    assert html.count("outside the 90% interval") == 2 and ">4.6e5<" in html
+    assert "touches lower bound" in html and "class=\"bound\"" in html  # zeta_v's interval reaches 1e-4
     assert "(between modes)" in html and "mode 2 (13% of the draws)" in html
     assert bound_hits({p: v for p, v in zip(PARAMS, [36.6, 5.1e5, -0.65, 0.135, 1e6, 1e-4])}, BOUNDS) == {
         "zeta_v": "lower"}
     page = landing_html(runs=pd.DataFrame({"run_id": ["a", "b"], "flags": ["", "clipped; snr"]}),
                         modal=pd.DataFrame({"run_id": ["a", "b"], "flags": ["", "unusable"]}),
-                        status={"first": (False, "NOT converged: 10.2 tau")}, notes={"first": ["MULTIMODAL (2 modes)"]})
+                        status={"first": (False, "NOT converged: 10.2 tau")}, notes={"first": ["MULTIMODAL (2 modes)"]},
+                        verdict="<ol><li>the verdict</li></ol>")
+    assert page.index("the verdict") < page.index("Run flags")
     assert "<b>1</b> of 2 runs (clipped: 1; snr: 1)" in page and "NOT converged: 10.2 tau" in page
 
 
@@ -113,3 +125,56 @@ def test_ramps_are_trimmed_from_the_envelopes():
     keep = steady_frames(env).to_numpy()
     assert keep[20:n - 20].all()  # the steady sweep is kept
     assert not keep[:18].any() and not keep[-18:].any()  # ramp frames below 95% of the level are dropped
+
+
+def _identified():
+    rows = [dict(quantity=p, unit="-", kind="parameter", log=p != "chi", q_in=np.nan, q05=v / 2, median=v, q95=2 * v,
+                 free_share=0.0 if ok else 1.0, identified=ok, fixed_directions=4.0)
+            for p, v, ok in (("Fs", 300.0, False), ("KT", 1e6, False), ("chi", -0.6, True), ("beta", 0.01, False),
+                             ("k", 6e5, False), ("zeta_v", 0.0015, True))]
+    rows.append(dict(quantity="K0", unit="lbf/in", kind="combination", log=True, q_in=np.nan, q05=1.62e6,
+                     median=1.63e6, q95=1.64e6, free_share=0.0, identified=True, fixed_directions=4.0))
+    return pd.DataFrame(rows)
+
+
+@pytest.mark.parametrize("newer", [False, True])
+def test_verdict_answers_in_order_and_reads_either_form_of_the_diagnosis(newer):
+    diag = {"effect": "fixture_flexibility", "confidence": "high", "metric_before": 17.13, "metric_after": 0.41,
+            "recalibrated": {"joint_parameters": {p: {"value": v, "interval_90": sorted([0.9 * v, 1.1 * v])} for p, v in
+                                                  (("Fs", 75.7), ("KT", 6.5e5), ("chi", -0.637), ("beta", 0.076),
+                                                   ("k", 8.9e5), ("zeta_v", 0.00176))},
+                             "effect_parameters": {"f_can_hz": {"value": 5617.0, "unit": "Hz",
+                                                                "interval_90": [5602.0, 5624.0]}}}}
+    if newer:
+        diag["effects"] = ["fixture_flexibility"]
+    nxt = {"recommended": {"level_g": 100.0, "direction": "up", "sweep_rate_hz_per_s": 1200.0, "duration_s": 1.5},
+           "targets": ["Fs", "KT/k"], "share_of_draws_identifying_targets": 0.16, "identifies_targets": False,
+           "confidence": 0.9, "max_level_g": 100.0, "width_now": {"Fs": 1.59, "KT/k": 2.3},
+           "predicted_width_ratio_if_identified": {"Fs": 18.3, "KT/k": 14.6},
+           "predicted_width_ratio": {"Fs": 1.6, "KT/k": 1.4}}
+    corrected = {"Fs": False, "KT": False, "chi": True, "beta": False, "k": False, "zeta_v": True}
+    items = verdict_items(best={"model_kind": "ministack", "excitation": "base"}, identified=_identified(),
+                          validation={"E": 17.13}, fit={"fit_chi2": 306.7, "fit_dof": 18.0, "fit_p": 2e-54},
+                          diagnosis=diag, next_test=nxt, corrected=corrected)
+    (q1, a1), (q2, a2), (q3, a3), (q4, a4) = items
+    assert "reproduce" in q1 and "<b>No</b>" in a1 and "17.13" in a1 and "p = 2e-54" in a1
+    assert "fixture_flexibility" in a2 and "<b>17.13</b> to <b>0.41</b>" in a2 and "5617" in a2
+    assert "chi -0.637 [-0.701, -0.573]" in a3 and "zeta_v 0.00176" in a3
+    assert "75.7" not in a3 and "6.5e5" not in a3 and "8.9e5" not in a3  # free directions: no value
+    assert "Left to the bounds (no value is given): Fs, KT, beta, k" in a3
+    assert "100 g base sweep, up, at 1200 Hz/s" in a4 and "16%" in a4 and "width ratio 18.3" in a4
+    page = verdict_html({"first": items})
+    assert page.index("reproduce") < page.index("discrepancy") < page.index("identify") < page.index("next test")
+    assert named_effects({"effect": "none"}) == [] and named_effects({"effects": ["a", "b"], "effect": "a+b"}) == ["a", "b"]
+
+
+def test_verdict_without_a_named_effect_reports_the_paper_models_identified_quantities():
+    items = verdict_items(best={"model_kind": "modal", "excitation": "force"}, identified=_identified(),
+                          validation={"E": 1.3}, fit={"fit_chi2": 20.0, "fit_dof": 18.0, "fit_p": 0.33},
+                          next_test={"recommended": None, "reason": "This campaign is force-driven.",
+                                     "what_would_identify": "A response amplitude past macroslip."})
+    a1, a2, a3, a4 = (a for _, a in items)
+    assert "<b>Yes</b>" in a1 and "agree with" in a1
+    assert "Not run" in a2 and "force-driven" in a2
+    assert "K0 = k + KT 1.63e6 [1.62e6, 1.64e6] lbf/in" in a3 and "Fs" in a3.split("Left to the bounds")[1]
+    assert "No level recommended" in a4 and "force-driven" in a4

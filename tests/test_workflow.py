@@ -93,3 +93,13 @@ def test_default_config_runs_on_the_example_campaign(workdir, tmp_path):
     for asm in ("first", "reassembly"):
         d = json.loads((out / "discrepancy" / asm / "diagnosis.json").read_text())
         assert d["effect"] == "fixture_flexibility" and d["metric_after"] < 0.3 * d["metric_before"]
+    for asm in ("first", "reassembly"):  # the design stage: a next test within the shaker limit, its predictions
+        nt = json.loads((out / "design" / asm / "next_test.json").read_text())
+        assert {"level_g", "direction", "sweep_rate_hz_per_s"} <= set(nt["recommended"])
+        assert nt["recommended"]["level_g"] <= 100.0 and {"Fs", "KT", "KT/k"} <= set(nt["predicted_width_ratio"])
+        assert (out / "figures" / f"next_test_{asm}.png").is_file() and (out / "design" / asm / "next_test.csv").is_file()
+    # the summary opens on the verdict, in its order, before Table 3.2 and the details
+    page = (out / "report" / "summary.html").read_text()
+    order = [page.index(s) for s in ("reproduce the measured envelopes", "fixture_flexibility",
+                                     "What do the data identify", "The next test", "Table 3.2", "Details")]
+    assert order == sorted(order)

@@ -27,7 +27,8 @@ SCRIPTS = REPO / "workflow" / "scripts"
 SCHEMA = REPO / "workflow" / "schemas" / "config.schema.yaml"
 DOWNSTREAM_OF_MODAL = {"modal_properties", "modal_figures", "calibrate_assembly", "calibration_figures",
                        "posterior_assembly", "posterior_corner", "posterior_report", "report_summary",
-                       "validate_assembly", "validate_figures", "discrepancy_assembly", "discrepancy_table"}
+                       "validate_assembly", "validate_figures", "discrepancy_assembly", "discrepancy_table",
+                       "design_assembly"}
 
 
 def _names(files: list[Path]) -> set[str]:
@@ -158,7 +159,8 @@ def test_editing_a_stage_module_reruns_that_stage_and_its_descendants_only(touch
     cases = [
         ("modal.py", DOWNSTREAM_OF_MODAL),  # not ingest, not envelopes
         ("report/calibration.py", {"calibration_figures", "posterior_corner", "posterior_report", "report_summary",
-                                    "validate_figures"}),  # figures and report pages only
+                                    "validate_figures", "design_assembly"}),  # figures and report pages only
+        ("design/narrowing.py", {"design_assembly", "report_summary"}),  # the design and the verdict that reads it
     ]
     for module, expected in cases:
         original = _edit(pkg / module)
@@ -201,7 +203,7 @@ def test_typo_in_config_is_one_line_before_any_schema_dump(touched):
     assert _jobs(_snakemake(work, "-n", *cfg, "posterior={ball: 0.002}")) == {
         "posterior_assembly": 1, "posterior_corner": 1, "posterior_report": 1, "report_summary": 1,
         "validate_assembly": 1, "validate_figures": 1, "discrepancy_assembly": 1, "discrepancy_table": 1,
-        "all": 1}  # params changed: the posterior and what uses its chain
+        "design_assembly": 1, "all": 1}  # params changed: the posterior and what uses its chain
 
 
 @pytest.mark.slow
@@ -219,7 +221,7 @@ def test_slurm_profile_dry_run_has_one_job_per_run_and_per_assembly(tmp_path):
                           "calibrate_assembly": 2, "calibration_figures": 2, "posterior_assembly": 2,
                           "posterior_corner": 2, "posterior_report": 1, "report_summary": 1,
                           "validate_assembly": 2, "validate_figures": 1, "discrepancy_assembly": 2,
-                          "discrepancy_table": 1, "all": 1}
+                          "discrepancy_table": 1, "design_assembly": 2, "all": 1}
     blocks = re.findall(r"rule (\w+):\n(?:    .*\n)*?    resources: (.*)", res.stdout + res.stderr)
     resources = {rule: dict(kv.split("=", 1) for kv in line.split(", ")) for rule, line in blocks}
     assert resources["calibrate_assembly"]["runtime"] == "30" and resources["posterior_assembly"]["runtime"] == "60"

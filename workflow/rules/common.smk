@@ -93,13 +93,30 @@ def run_record(wildcards):
 
 def ingest_table(wildcards):
     """The ingest stage's runs.csv when the workflow has that stage (one of calibrate + posterior only has not)."""
+    return [str(RESULTS / "ingest" / "runs.csv")] if has_rule("ingest") else []
+
+
+def has_rule(name):
+    """Whether this workflow defines rule `name` (called when the DAG is built, after every include)."""
     from snakemake.exceptions import WorkflowError
 
     try:
-        rules.ingest
+        getattr(rules, name)
     except (WorkflowError, AttributeError):
-        return []
-    return [str(RESULTS / "ingest" / "runs.csv")]
+        return False
+    return True
+
+
+def verdict_inputs(wildcards):
+    """The later stages' outputs the verdict reads, for the stages this workflow has."""
+    out = {}
+    if has_rule("validate_assembly"):
+        out["validation"] = [str(RESULTS / "validation" / a / "summary.json") for a in ASSEMBLIES]
+    if has_rule("discrepancy_assembly") and EXCITATION == "base":
+        out["diagnosis"] = [str(RESULTS / "discrepancy" / a / "diagnosis.json") for a in ASSEMBLIES]
+    if has_rule("design_assembly"):
+        out["design"] = [str(RESULTS / "design" / a / "next_test.json") for a in ASSEMBLIES]
+    return out
 
 
 def assembly_records(wildcards):

@@ -15,6 +15,7 @@ rule posterior_assembly:
         chain=POSTERIOR / "{assembly}" / "chain.npz",
         constraints=POSTERIOR / "{assembly}" / "constraints.txt",
         predictive=POSTERIOR / "{assembly}" / "predictive.csv",
+        identified=POSTERIOR / "{assembly}" / "identified.csv",
     params:
         code=source_hash("posterior.py"),
         calibrate=config.get("calibrate", {}),
@@ -63,6 +64,7 @@ rule posterior_report:
         curves=expand(RESULTS / "calibration" / "{assembly}" / "model_curves.csv", assembly=ASSEMBLIES),
         summary=expand(POSTERIOR / "{assembly}" / "summary.csv", assembly=ASSEMBLIES),
         predictive=expand(POSTERIOR / "{assembly}" / "predictive.csv", assembly=ASSEMBLIES),
+        identified=expand(POSTERIOR / "{assembly}" / "identified.csv", assembly=ASSEMBLIES),
     output:
         figure=report(RESULTS / "figures" / "fig3_8_amplitude_fit.png", caption="../report/fig3_8_amplitude_fit.rst",
                       category="3. Posterior"),
@@ -82,38 +84,8 @@ rule posterior_report:
         "../scripts/posterior_report.py"
 
 
-rule report_summary:
-    input:
-        runs=ingest_table,
-        modal=RESULTS / "modal" / "modal_properties.csv",
-        table=POSTERIOR / "table_3_2.csv",
-        history=expand(RESULTS / "calibration" / "{assembly}" / "ga_history.csv", assembly=ASSEMBLIES),
-        best=expand(RESULTS / "calibration" / "{assembly}" / "ga_best.json", assembly=ASSEMBLIES),
-        chain=expand(POSTERIOR / "{assembly}" / "chain.npz", assembly=ASSEMBLIES),
-        constraints=expand(POSTERIOR / "{assembly}" / "constraints.txt", assembly=ASSEMBLIES),
-    output:
-        summary=report(RESULTS / "report" / "summary.html", caption="../report/summary.rst",
-                       category="0. Summary"),
-        table=report(POSTERIOR / "table_3_2.html", caption="../report/table_3_2.rst", category="3. Posterior"),
-        landing=RESULTS / "report" / "landing.html",
-    params:
-        code=source_hash("report_summary.py"),
-        calibrate=config.get("calibrate", {}),
-        posterior=config.get("posterior", {}),
-        assemblies=ASSEMBLIES,
-        campaign=str(RAW_DATA),
-    threads: 1
-    benchmark:
-        RESULTS / "benchmarks" / "report_summary.tsv"
-    log:
-        RESULTS / "logs" / "report_summary.log",
-    script:
-        "../scripts/report_summary.py"
-
-
 rule posterior:
     input:
-        rules.report_summary.output,
         expand(POSTERIOR / "{assembly}" / "summary.csv", assembly=ASSEMBLIES),
         expand(RESULTS / "figures" / "corner_{assembly}.png", assembly=ASSEMBLIES),
         rules.posterior_report.output,

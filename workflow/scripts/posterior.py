@@ -1,15 +1,34 @@
 """Snakemake script of rule ``posterior_assembly``: emcee around the GA optimum of one assembly.
 
 Writes summary.csv, chain.npz, constraints.txt and predictive.csv; resumes from the chain
-checkpoint in params.checkpoint when it matches. Floors applied to the noise scales and
+checkpoint in params.checkpoint when it matches. Then identified.csv: which parameters and
+combinations the data identify, from the draws (jointcal.posterior.identified). Floors applied to the noise scales and
 a chain stopped by max_steps before 50 tau are reported on stderr and in the log.
 (No ``from __future__``: Snakemake prepends a preamble to scripts.)
 """
+import json
 import sys
 from pathlib import Path
 
-from jointcal.calibrate import CalibrateSettings, CalibrationInputError
+import numpy as np
+
+from jointcal.calibrate import CalibrateSettings, CalibrationInputError, read_modal
+from jointcal.io import write_csv_atomic
 from jointcal.posterior import PosteriorSettings, run_posterior
+from jointcal.posterior.identified import identified_table
+
+
+def write_identified(smk, cal: CalibrateSettings, post: PosteriorSettings) -> str:
+    """identified.csv from the chain just written; returns a line for the log."""
+    cal = cal.resolved(json.loads(Path(smk.input.best).read_text()))
+    data = read_modal(smk.input.modal, smk.wildcards.assembly, damping=cal.damping)
+    with np.load(smk.output.chain) as z:
+        table, _ = identified_table(z["samples"], [str(n) for n in z["sample_names"]], cal.space, data.q, data.f,
+                                    data.zeta, m=cal.m, model=cal.model, viscous=cal.viscous,
+                                    ratio=post.constrained_ratio)
+    write_csv_atomic(table, smk.output.identified)
+    return ("identified: " + ", ".join(table.loc[table["identified"], "quantity"]) + "; left to the bounds: "
+            + ", ".join(table.loc[~table["identified"], "quantity"]))
 
 
 def main(smk) -> None:
@@ -25,6 +44,7 @@ def main(smk) -> None:
         res, notes = run_posterior(smk.input.modal, smk.input.scatter, smk.input.best, smk.wildcards.assembly,
                                    Path(smk.output.summary).parent, cal, post, checkpoint=smk.params.checkpoint,
                                    progress=progress)
+        notes.append(write_identified(smk, cal, post))
     except (CalibrationInputError, ValueError) as exc:
         progress(str(exc))
         sys.exit(f"jointcal: {exc}")

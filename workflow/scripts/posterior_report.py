@@ -31,7 +31,8 @@ def main(smk) -> None:
     curves = {a: pd.read_csv(p) for a, p in zip(names, smk.input.curves)}
     bands = {a: pd.read_csv(p) for a, p in zip(names, smk.input.predictive)}
     write_bytes_atomic(amplitude_figure(measured, curves, bands, model=cal.model), smk.output.figure)
-    table = table_3_2(best, summaries)
+    identified = {a: pd.read_csv(p) for a, p in zip(names, smk.input.identified)}
+    table = table_3_2(best, summaries, identified)
     write_csv_atomic(table, smk.output.table)
     write_bytes_atomic(table_3_2_markdown(table).encode(), smk.output.markdown)
     qvh = pd.concat(comparison, ignore_index=True)

@@ -11,7 +11,8 @@ Outputs in ``out_dir`` (all written atomically):
   ``converged``, ``stop_reason`` ("converged", "max_steps" or "projected"),
   ``projected_steps``, ``sample_mode`` (the separated mode of each draw, 0 = heaviest,
   `jointcal.posterior.modes`), ``fit_ratio`` (rms relative residuals of the GA optimum
-  over the repeat scatter, frequency and damping) and emcee's RandomState (``rs_*``);
+  over the repeat scatter, frequency and damping), ``fit_chi2``, ``fit_dof``, ``fit_p`` (its
+  chi-square test against the repeat scatter, `fit_test`) and emcee's RandomState (``rs_*``);
 * ``constraints.txt`` -- convergence (and why the chain stopped), the fit of the optimum
   against the repeat scatter, the modes, then one sentence per parameter and correlation;
 * ``predictive.csv`` -- q_in, f_q05, f_q50, f_q95, zeta_q05, zeta_q50, zeta_q95.
@@ -42,9 +43,10 @@ from .sampler import ChainResult, random_state_arrays, random_state_tuple, run_c
 from .settings import PosteriorSettings
 from .summary import NAMES, burn_in, constraints_text, predictive_band, summarize
 
-__all__ = ["OUTPUTS", "start_ball", "run_posterior", "goodness_of_fit"]
+__all__ = ["OUTPUTS", "P_REJECT", "start_ball", "run_posterior", "goodness_of_fit", "fit_test"]
 
 OUTPUTS = ("summary.csv", "chain.npz", "constraints.txt", "predictive.csv")
+P_REJECT = 1e-3  # chi-square probability below which the data reject the model
 
 
 def start_ball(lp: LogPosterior, theta: np.ndarray, ps: PosteriorSettings) -> np.ndarray:
@@ -62,7 +64,7 @@ def start_ball(lp: LogPosterior, theta: np.ndarray, ps: PosteriorSettings) -> np
     return lp.to_y(x0)
 
 
-def goodness_of_fit(lp: LogPosterior, theta: np.ndarray, p_reject: float = 1e-3) -> tuple[list[float], str]:
+def goodness_of_fit(lp: LogPosterior, theta: np.ndarray, p_reject: float = P_REJECT) -> tuple[list[float], str]:
     """How far the GA optimum misses the data, against the repeat scatter (the noise floors).
 
     Parameters
@@ -80,23 +82,31 @@ def goodness_of_fit(lp: LogPosterior, theta: np.ndarray, p_reject: float = 1e-3)
         rms relative residual of f and of zeta divided by its repeat scatter.
     sentence : str
     """
-    from scipy.stats import chi2
-
     x = lp.space.to_unit(theta) * (lp.space.x_hi - lp.space.x_lo) + lp.space.x_lo
     r_f, r_z = lp.residuals(x[None])
     s_f, s_z = lp.data.rel_noise
     rms = [float(np.sqrt(np.mean(r_f**2))), float(np.sqrt(np.mean(r_z**2)))]
     ratios = [rms[0] / s_f, rms[1] / s_z]
-    n = r_f.size
-    stat = float(np.sum((r_f / s_f) ** 2) + np.sum((r_z / s_z) ** 2))
-    dof = max(2 * n - len(theta), 1)
-    p = float(chi2.sf(stat, dof))
+    test = fit_test(lp, theta)
+    stat, dof, p = test["fit_chi2"], int(test["fit_dof"]), test["fit_p"]
     verdict = ("the data reject the model at the precision of the repeats (model error, not noise, sets the "
                "noise scales, which widen the intervals)" if p < p_reject else
                "consistent with the repeat scatter")
     return ratios, (f"Fit of the GA optimum: rms relative residuals {rms[0]:.2g} (frequency) and {rms[1]:.2g} "
                     f"(damping) = {ratios[0]:.1f} and {ratios[1]:.1f} x the repeat scatter; chi-square {stat:.0f} "
                     f"for {dof} degrees of freedom (p = {p:.1g}): {verdict}.")
+
+
+def fit_test(lp: LogPosterior, theta: np.ndarray) -> dict[str, float]:
+    """The chi-square test of `goodness_of_fit` as numbers: fit_chi2, fit_dof, fit_p (stored in chain.npz)."""
+    from scipy.stats import chi2
+
+    x = lp.space.to_unit(theta) * (lp.space.x_hi - lp.space.x_lo) + lp.space.x_lo
+    r_f, r_z = lp.residuals(x[None])
+    s_f, s_z = lp.data.rel_noise
+    stat = float(np.sum((r_f / s_f) ** 2) + np.sum((r_z / s_z) ** 2))
+    dof = max(2 * r_f.size - len(theta), 1)
+    return {"fit_chi2": stat, "fit_dof": float(dof), "fit_p": float(chi2.sf(stat, dof))}
 
 
 def _npz(arrays: dict) -> bytes:
@@ -227,7 +237,7 @@ def run_posterior(modal_csv: str | os.PathLike[str], scatter_csv: str | os.PathL
     final = arrays(res.chain, res.log_prob, res.random_state, res.tau_history, res.acceptance * res.steps)
     final.update(samples=samples, sample_names=np.array(NAMES), burn=burn, converged=res.converged,
                  stop_reason=np.array(res.stop_reason), projected_steps=res.projected_steps,
-                 sample_mode=labels[pick], fit_ratio=np.asarray(fit_ratio))
+                 sample_mode=labels[pick], fit_ratio=np.asarray(fit_ratio), **fit_test(lp, theta))
     write_bytes_atomic(_npz(final), out / "chain.npz")
     (out / "constraints.txt").parent.mkdir(parents=True, exist_ok=True)
     write_bytes_atomic(text.encode(), out / "constraints.txt")

@@ -5,10 +5,11 @@ Pure functions from the stages' outputs to text and HTML:
 * `ga_best_point` -- the GA's own best individual (the polish may move far from it);
 * `bound_hits` -- parameters at a search bound;
 * `chain_status` -- one line per posterior: steps in units of tau, converged or why not;
-* `table_3_2_html` -- Table 3.2 with the GA best, the polished optimum and the posterior
-  side by side, bound hits, unconstrained parameters and separated modes marked;
-* `summary_html` -- the campaign, the flags counted, the convergence lines, the
-  constraints in words and Table 3.2, as one HTML fragment.
+* `table_3_2_html` -- Table 3.2 in the paper's layout: the posterior (parameters the data
+  leave to the bounds marked, no value given), then the GA's points as members of it;
+* `summary_html` -- the verdict (`jointcal.report.verdict`), what the data identify,
+  Table 3.2, then the campaign, the flags counted, the convergence and the fit, as one page;
+* `landing_html` -- the verdict and the details in a few lines for the landing page.
 """
 from __future__ import annotations
 
@@ -20,7 +21,8 @@ import pandas as pd
 
 from ..calibrate.space import LOG_SCALED, PARAMS, UNITS
 
-__all__ = ["rst_escape", "ga_best_point", "bound_hits", "chain_status", "table_3_2_html", "summary_html", "landing_html", "fmt"]
+__all__ = ["rst_escape", "ga_best_point", "bound_hits", "chain_status", "table_3_2_html", "summary_html", "landing_html",
+           "fmt"]
 
 
 def rst_escape(text: str) -> str:
@@ -107,9 +109,13 @@ def chain_status(z: Mapping, *, tau_factor: float = 50.0) -> tuple[bool, str]:
 
 _CSS = """<style>
 body{font-family:sans-serif;margin:1em}
-.jc-summary{font-size:14px;line-height:1.4}
-.jc-summary table{border-collapse:collapse;margin:0.4em 0 1em 0;font-size:13px}
-.jc-summary th,.jc-summary td{border:1px solid #bbb;padding:2px 6px;text-align:right;white-space:nowrap}
+.jc-summary{font-size:14px;line-height:1.4;max-width:1250px}
+.jc-summary table{border-collapse:collapse;margin:0.4em 0 1em 0;font-size:13px;max-width:1250px}
+.jc-summary th,.jc-summary td{border:1px solid #bbb;padding:2px 6px;text-align:right;white-space:normal;
+  vertical-align:top}
+.jc-summary table.t32 td{min-width:7em}
+.jc-summary table.ident td.lab{max-width:38em}
+.jc-summary ol.verdict li{margin-bottom:0.4em}
 .jc-summary th{background:#eee}
 .jc-summary td.lab{text-align:left}
 .jc-summary td.bound{background:#fde2c4}
@@ -123,11 +129,27 @@ def _cell(text: str, cls: str = "") -> str:
     return f'<td class="{cls}">{text}</td>' if cls else f"<td>{text}</td>"
 
 
+def _identified_params(identified: pd.DataFrame | None) -> dict[str, bool] | None:
+    """param -> identified, from an identified.csv table (None when not given)."""
+    if identified is None:
+        return None
+    t = identified.set_index("quantity")
+    return {p: bool(t.loc[p, "identified"]) for p in PARAMS if p in t.index}
+
+
+def _member(v: float, lo: float, hi: float) -> str:
+    """A point of the GA shown as a member of the posterior: its value where the 90% interval holds it."""
+    if np.isfinite(lo) and np.isfinite(hi) and not lo <= v <= hi:
+        return "<span class='bad'>outside the 90% interval</span>"
+    return fmt(v)
+
+
 def table_3_2_html(table: pd.DataFrame, ga_points: Mapping[str, Mapping[str, float]],
                    modes: Mapping[str, pd.DataFrame] | None = None,
                    bounds: Mapping[str, Sequence[float]] | Mapping[str, Mapping[str, Sequence[float]]] | None = None,
-                   model_notes: Mapping[str, str] | None = None) -> str:
-    """Table 3.2 as an HTML table: per assembly, GA best, polished optimum, posterior, and each mode.
+                   model_notes: Mapping[str, str] | None = None,
+                   identified: Mapping[str, pd.DataFrame] | None = None) -> str:
+    """Table 3.2 in the paper's layout: per assembly the posterior, then the GA's points as members of it.
 
     Parameters
     ----------
@@ -139,58 +161,74 @@ def table_3_2_html(table: pd.DataFrame, ga_points: Mapping[str, Mapping[str, flo
         `jointcal.posterior.find_modes` tables; with two or more modes each gets a row.
     bounds : mapping param -> (lo, hi), or assembly -> param -> (lo, hi), optional
         Search bounds (one set, or each assembly's: a modal model's come from its data):
-        values at a bound are marked.
+        intervals that reach a bound are marked.
     model_notes : mapping assembly -> str, optional
         What the parameters mean for each assembly's model (`jointcal.calibrate.model_words`),
         printed under the table where it is not the paper's Ministack.
+    identified : mapping assembly -> DataFrame, optional
+        identified.csv of each assembly (`jointcal.posterior.identified`). A parameter the data
+        leave to the bounds gets no value in any row: "not identified" and the range the bounds
+        leave it. Without it the posterior's width ratio decides (the older, bound-dependent rule).
     """
     head = "".join(f"<th>{p} ({html.escape(UNITS[p])})</th>" for p in PARAMS)
-    rows = [f"<table><tr><th>assembly</th><th>estimate</th>{head}</tr>"]
+    rows = [f"<table class='t32'><tr><th>assembly</th><th>estimate</th>{head}</tr>"]
     all_bounds = bounds
     for name, g in table.groupby("assembly", sort=False):
         bounds = (all_bounds.get(name) if all_bounds and isinstance(all_bounds.get(name), Mapping)
                   else all_bounds)
         g = g.set_index("param")
-        polished = {p: float(g.loc[p, "ga_optimum"]) for p in PARAMS}
-        m = None if modes is None else modes.get(name)
-        n_modes = 0 if m is None or m.empty else int(m["mode"].max()) + 1
-        lines = [("GA best (before polish)", ga_points[name]), ("polished optimum", polished)]
-        for label, point in lines:
-            hits = bound_hits(point, bounds) if bounds else {}
-            cells = [_cell(fmt(point[p]) + (f" ({hits[p]} bound)" if p in hits else ""), "bound" if p in hits else "")
-                     for p in PARAMS]
-            rows.append(f"<tr><td class='lab'>{html.escape(name)}</td><td class='lab'>{label}</td>{''.join(cells)}</tr>")
+        ident = _identified_params(identified.get(name) if identified else None)
+        free = {p: (not ident[p]) if ident is not None and p in ident
+                else (g.loc[p, "constrained"] is False or g.loc[p, "constrained"] == False)  # noqa: E712
+                for p in PARAMS}
+        lo = {p: float(g.loc[p, "posterior_q05"]) for p in PARAMS}
+        hi = {p: float(g.loc[p, "posterior_q95"]) for p in PARAMS}
         cells = []
         for p in PARAMS:
             r = g.loc[p]
-            free = r["constrained"] is False or r["constrained"] == False  # noqa: E712
-            text = f"{fmt(r['posterior_median'])} [{fmt(r['posterior_q05'])}, {fmt(r['posterior_q95'])}]"
-            edge = _touches(p, r["posterior_q05"], r["posterior_q95"], bounds) if bounds else None
-            note = f" (touches {edge} bound)" if edge else ""
-            cells.append(_cell(text + ("*" if free else "") + note, "bound" if edge else ("free" if free else "")))
-        label = "posterior median [q05, q95]" + (" <span class='bad'>(between modes)</span>" if n_modes > 1 else "")
+            if free[p]:
+                cells.append(_cell(f"<i>not identified</i><br><small>spans {fmt(lo[p])} to {fmt(hi[p])} (bounds)</small>",
+                                   "free"))
+                continue
+            edge = _touches(p, lo[p], hi[p], bounds) if bounds else None
+            note = f"<br><small>(touches {edge} bound)</small>" if edge else ""
+            cells.append(_cell(f"{fmt(r['posterior_median'])}<br><small>[{fmt(lo[p])}, {fmt(hi[p])}]</small>{note}",
+                               "bound" if edge else ""))
+        m = None if modes is None else modes.get(name)
+        n_modes = 0 if m is None or m.empty else int(m["mode"].max()) + 1
+        label = "posterior median<br>[90% interval]" + (" <span class='bad'>(between modes)</span>" if n_modes > 1 else "")
         rows.append(f"<tr><td class='lab'>{html.escape(name)}</td><td class='lab'>{label}</td>{''.join(cells)}</tr>")
         for k in range(n_modes if n_modes > 1 else 0):
             mk = m[m["mode"] == k].set_index("param")
-            cells = [_cell(f"{fmt(mk.loc[p, 'median'])} [{fmt(mk.loc[p, 'q05'])}, {fmt(mk.loc[p, 'q95'])}]")
-                     for p in PARAMS]
+            cells = [_cell("-" if free[p] else f"{fmt(mk.loc[p, 'median'])}<br><small>[{fmt(mk.loc[p, 'q05'])}, "
+                           f"{fmt(mk.loc[p, 'q95'])}]</small>") for p in PARAMS]
             w = 100 * float(mk["weight"].iloc[0])
             rows.append(f"<tr><td class='lab'>{html.escape(name)}</td><td class='lab'>mode {k + 1} ({w:.0f}% of the "
                         f"draws)</td>{''.join(cells)}</tr>")
+        polished = {p: float(g.loc[p, "ga_optimum"]) for p in PARAMS}
+        for label, point in (("polished optimum<br><small>(one member of the posterior's set)</small>", polished),
+                             ("GA best before polish<br><small>(one member)</small>", ga_points[name])):
+            cells = [_cell("-" if free[p] else _member(float(point[p]), lo[p], hi[p])) for p in PARAMS]
+            rows.append(f"<tr><td class='lab'>{html.escape(name)}</td><td class='lab'>{label}</td>{''.join(cells)}</tr>")
     rows.append("</table>")
     for name, words in (model_notes or {}).items():
         if not words.startswith("The paper's Ministack"):
             rows.append(f"<p><b>{html.escape(name)}</b>: {html.escape(words)}</p>")
-    rows.append("<p>* not constrained by the data (posterior 90% interval spans at least half the prior range). "
-                "Orange: at a search bound. The GA best is the GA's own best individual; the polished optimum is "
-                "what least squares made of the best distinct individuals (<code>ga_best.json</code>) and is where the "
-                "posterior starts.</p>")
+    rows.append("<p><i>Not identified</i>: the data leave the parameter to the bounds (most of its posterior variance "
+                "lies along directions the measurements do not constrain), so no value of it is given; the range is "
+                "what the bounds and the identified combinations leave. Orange: a 90% interval that reaches a search "
+                "bound. The polished optimum (<code>ga_best.json</code>, where the chain starts) and the GA's own best "
+                "are single members of the posterior's set: their identified values are shown where the posterior's "
+                "90% interval holds them, and any value of the other parameters in their range fits the data as "
+                "well.</p>")
     return "\n".join(rows)
 
 
 def summary_html(*, campaign: str, runs: pd.DataFrame, modal: pd.DataFrame, status: Mapping[str, tuple[bool, str]],
-                 constraints: Mapping[str, str], table_html: str, fits: Mapping[str, str] | None = None) -> str:
-    """The report's opening summary as an HTML fragment.
+                 constraints: Mapping[str, str], table_html: str, fits: Mapping[str, str] | None = None,
+                 verdict: str = "", identified: str = "") -> str:
+    """The report's opening summary as an HTML fragment: the verdict, what the data identify, Table 3.2,
+    then the details (campaign, run flags, convergence, the constraint sentences).
 
     Parameters
     ----------
@@ -208,9 +246,15 @@ def summary_html(*, campaign: str, runs: pd.DataFrame, modal: pd.DataFrame, stat
         `table_3_2_html`.
     fits : mapping assembly -> str, optional
         Extra sentences per assembly.
+    verdict : str
+        `jointcal.report.verdict.verdict_html`: opens the page.
+    identified : str
+        `jointcal.report.verdict.identified_html` of each assembly, after the verdict.
     """
     out = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>jointcal summary</title>", _CSS,
-           "</head><body>", '<div class="jc-summary">', "<h2>jointcal: summary of this run</h2>"]
+           "</head><body>", '<div class="jc-summary">', "<h2>jointcal: summary of this run</h2>", verdict, identified,
+           "<p><b>Table 3.2</b> (the paper's calibrated parameters, in its layout)</p>", table_html,
+           "<h3>Details</h3>"]
     n_asm = runs["assembly"].nunique() if "assembly" in runs else 0
     level = "level_g" if "level_g" in runs.columns else ("level_lbf" if "level_lbf" in runs.columns else None)
     levels = "" if level is None else ", levels " + ", ".join(f"{v:g}" for v in sorted(runs[level].dropna().unique()))
@@ -227,10 +271,8 @@ def summary_html(*, campaign: str, runs: pd.DataFrame, modal: pd.DataFrame, stat
         cls = "good" if ok else "bad"
         out.append(f"<li>{html.escape(name)}: <span class='{cls}'>{html.escape(line)}</span></li>")
     out.append("</ul>")
-    out.append("<p><b>Table 3.2</b> (the paper's calibrated parameters)</p>")
-    out.append(table_html)
     for name, text in constraints.items():
-        out.append(f"<p><b>What the data constrain: {html.escape(name)}</b></p><ul>")
+        out.append(f"<p><b>The posterior of {html.escape(name)}</b></p><ul>")
         out.extend(f"<li>{html.escape(s)}</li>" for s in text.strip().splitlines() if s.strip())
         if fits and name in fits:
             out.append(f"<li>{html.escape(fits[name])}</li>")
@@ -252,21 +294,23 @@ def _flag_counts(t: pd.DataFrame) -> tuple[int, str]:
 
 
 def landing_html(*, runs: pd.DataFrame, modal: pd.DataFrame, status: Mapping[str, tuple[bool, str]],
-                 notes: Mapping[str, Sequence[str]] | None = None) -> str:
-    """A few lines for the report's landing page: run flags counted and each posterior's convergence.
+                 notes: Mapping[str, Sequence[str]] | None = None, verdict: str = "") -> str:
+    """The report's landing text: the verdict of the run (``verdict``,
+    `jointcal.report.verdict.landing_verdict`), then run flags counted and each posterior's convergence.
 
     Short on purpose: Snakemake's landing page centres its content and clips a long one.
     ``notes`` adds short warnings per assembly (e.g. multimodal, a parameter at a bound).
     """
-    out = ['<div style="font-size:13px;line-height:1.35">']
+    out = [verdict, '<div style="font-size:12px;line-height:1.3;color:#444;text-align:left">'
+           "<div><b>Details</b></div>"]
     for label, t in (("ingest", runs), ("modal", modal)):
         n, detail = _flag_counts(t)
         out.append(f"<div>Run flags, {label}: <b>{n}</b> of {len(t)} runs"
                    + (f" ({html.escape(detail)})" if detail else "") + "</div>")
     for name, (ok, line) in status.items():
-        colour = "#006400" if ok else "#b00000"
+        colour = "#006400" if ok else "#8a4b00"
         extra = "".join(f"; {html.escape(n)}" for n in (notes or {}).get(name, ()))
-        out.append(f"<div>Posterior <b>{html.escape(name)}</b>: <span style='color:{colour};font-weight:bold'>"
+        out.append(f"<div>Posterior chain <b>{html.escape(name)}</b>: <span style='color:{colour}'>"
                    f"{html.escape(line)}</span>{extra}</div>")
     out.append("</div>")
     return "\n".join(out) + "\n"

@@ -17,7 +17,8 @@ from ..calibrate.space import PARAMS, UNITS
 __all__ = ["table_3_2", "table_3_2_markdown", "qsma_vs_harmonic_balance"]
 
 
-def table_3_2(ga_best: Mapping[str, Mapping], summaries: Mapping[str, pd.DataFrame]) -> pd.DataFrame:
+def table_3_2(ga_best: Mapping[str, Mapping], summaries: Mapping[str, pd.DataFrame],
+              identified: Mapping[str, pd.DataFrame] | None = None) -> pd.DataFrame:
     """Table 3.2: per assembly and parameter, the GA optimum and the posterior median [q05, q95].
 
     Parameters
@@ -26,17 +27,21 @@ def table_3_2(ga_best: Mapping[str, Mapping], summaries: Mapping[str, pd.DataFra
         Contents of each ``ga_best.json``.
     summaries : mapping assembly -> DataFrame
         Each ``summary.csv`` (may miss assemblies: their posterior columns are NaN).
+    identified : mapping assembly -> DataFrame, optional
+        Each ``identified.csv`` (`jointcal.posterior.identified`): which parameters the data
+        identify (column identified; None where not given).
 
     Returns
     -------
     pandas.DataFrame
         Columns assembly, param, unit, ga_optimum, posterior_median, posterior_q05,
-        posterior_q95, width_ratio, constrained.
+        posterior_q95, width_ratio, constrained, identified.
     """
     rows = []
     for name, best in ga_best.items():
         s = summaries.get(name)
         s = s.set_index("param") if s is not None else None
+        ident = None if not identified or name not in identified else identified[name].set_index("quantity")
         for p in PARAMS:
             post = s.loc[p] if s is not None and p in s.index else None
             rows.append(dict(assembly=name, param=p, unit=UNITS[p], ga_optimum=float(best[p]),
@@ -44,7 +49,8 @@ def table_3_2(ga_best: Mapping[str, Mapping], summaries: Mapping[str, pd.DataFra
                              posterior_q05=np.nan if post is None else float(post["q05"]),
                              posterior_q95=np.nan if post is None else float(post["q95"]),
                              width_ratio=np.nan if post is None else float(post["width_ratio"]),
-                             constrained=None if post is None else bool(post["constrained"])))
+                             constrained=None if post is None else bool(post["constrained"]),
+                             identified=None if ident is None else bool(ident.loc[p, "identified"])))
     return pd.DataFrame(rows)
 
 
@@ -57,25 +63,40 @@ def _g(v: float) -> str:
     return f"{float(mant):.3g}e{int(exp)}"
 
 
+def _free(r: pd.Series) -> bool:
+    """Left to the bounds: by identified.csv where the table has it, else by the posterior's width ratio."""
+    flag = r.get("identified")
+    if flag is not None and not pd.isna(flag):
+        return not bool(flag)
+    return r["constrained"] is False or r["constrained"] == False  # noqa: E712
+
+
 def table_3_2_markdown(table: pd.DataFrame) -> str:
     """Markdown rendering in the paper's layout: one row per assembly and estimate, one column per parameter.
 
-    Posterior cells read ``median [q05, q95]``; a parameter the data do not constrain
-    (posterior 90% width >= half the prior width) is marked with an asterisk.
+    Posterior cells read ``median [q05, q95]``; a parameter the data leave to the bounds
+    (identified.csv, or else a posterior 90% width >= half the prior width) reads "not
+    identified" with the range the bounds leave it, in every row: the GA optimum is given
+    for the identified parameters only, as one member of the posterior's set.
     """
     head = "| assembly | estimate | " + " | ".join(f"{p} ({UNITS[p]})" for p in PARAMS) + " |"
     lines = [head, "|" + "---|" * (len(PARAMS) + 2)]
     for name, g in table.groupby("assembly", sort=False):
         g = g.set_index("param")
-        lines.append(f"| {name} | GA optimum | " + " | ".join(_g(g.loc[p, "ga_optimum"]) for p in PARAMS) + " |")
+        free = {p: _free(g.loc[p]) for p in PARAMS}
         cells = []
         for p in PARAMS:
             r = g.loc[p]
-            star = "*" if r["constrained"] is False or r["constrained"] == False else ""  # noqa: E712
-            cells.append(f"{_g(r['posterior_median'])} [{_g(r['posterior_q05'])}, {_g(r['posterior_q95'])}]{star}")
+            cells.append(f"not identified (spans {_g(r['posterior_q05'])} to {_g(r['posterior_q95'])})" if free[p] else
+                         f"{_g(r['posterior_median'])} [{_g(r['posterior_q05'])}, {_g(r['posterior_q95'])}]")
         lines.append(f"| {name} | posterior median [q05, q95] | " + " | ".join(cells) + " |")
+        member = ["-" if free[p] else _g(g.loc[p, "ga_optimum"])
+                  if g.loc[p, "posterior_q05"] <= g.loc[p, "ga_optimum"] <= g.loc[p, "posterior_q95"]
+                  or not np.isfinite(g.loc[p, "posterior_q05"]) else "outside the 90% interval" for p in PARAMS]
+        lines.append(f"| {name} | GA optimum (one member of the posterior's set) | " + " | ".join(member) + " |")
     lines.append("")
-    lines.append("\\* not constrained by the data: the posterior 90% interval spans at least half the prior range.")
+    lines.append("Not identified: the data leave the parameter to the bounds; no value of it is given, only the range "
+                 "the bounds and the identified combinations leave it.")
     return "\n".join(lines) + "\n"
 
 

@@ -11,7 +11,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
-__all__ = ["BINS", "repeat_scatter", "envelope_error", "describe_misfit"]
+__all__ = ["BINS", "repeat_scatter", "envelope_error", "closeness", "describe_misfit"]
 
 BINS = (0.0, 1.0, 3.0, np.inf)  # |x| = |f/f_res - 1| / zeta: within half-power, flanks, far
 
@@ -155,13 +155,18 @@ def _pct(x: float) -> str:
     return f"{abs(x) * 100:.1f}%"
 
 
+def closeness(E: float) -> str:
+    """How close a model's envelopes are to the measured ones, in words, from E (1 = the repeat scatter)."""
+    return ("about as close as a repeated test" if E <= 2 else
+            "clearly outside the repeat scatter" if E > 5 else "somewhat outside the repeat scatter")
+
+
 def describe_misfit(metrics: pd.DataFrame, err: Mapping, *, level_unit: str = "g") -> str:
     """The misfit in plain words: E, peak amplitude, resonance, damping, far below resonance."""
     m = metrics[metrics["n_frames"] > 0]
     if m.empty:
         return "no usable run to compare."
-    verdict = ("about as close as a repeated test" if err["E"] <= 2 else
-               "clearly outside the repeat scatter" if err["E"] > 5 else "somewhat outside the repeat scatter")
+    verdict = closeness(err["E"])
     words = [f"validation envelope error E = {err['E']:.2f} (magnitude {err['E_mag']:.2f}, phase "
              f"{err['E_phase']:.2f}; 1 = the repeat-to-repeat scatter): {verdict}."]
     pr = float(np.nanmedian(m["peak_ratio"]))

@@ -1,0 +1,214 @@
+"""The verdict of the whole run, in the order a test engineer asks, and what the data identify.
+
+Pure functions from the stages' outputs to HTML fragments of the report's summary and landing page:
+
+1. Does the paper's model reproduce the measured envelopes? The validation stage's E
+   (1 = the repeat scatter, `jointcal.validate.error.closeness`) and the chi-square test
+   of the calibrated frequencies and damping ratios against the repeats (``chain.npz``).
+2. What did the discrepancy stage name, and what did the correction change (E before and
+   after, ``diagnosis.json`` read as it is)?
+3. The identified quantities of the model that holds: the corrected one where an effect
+   was named and brings E within the scatter, else the paper's. Which quantities the data
+   identify comes from the posterior (``identified.csv``, `jointcal.posterior.identified`);
+   the corrected model's values and intervals from ``diagnosis.json``, and which of its
+   parameters the runs identify from the read-outs at its point
+   (`jointcal.posterior.identified.identified_at`). Quantities the data leave to the bounds
+   are named, never given a value.
+4. The next test (``next_test.json``).
+"""
+from __future__ import annotations
+
+import html
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from ..calibrate.space import PARAMS
+from ..posterior.stage import P_REJECT
+from ..validate.error import closeness
+from .summary import fmt as _g
+
+__all__ = ["HOLDS_E", "named_effects", "corrected_holds", "verdict_items", "identified_html", "verdict_html"]
+
+HOLDS_E = 2.0  # a model holds when its E is "about as close as a repeated test" (closeness)
+_WORDS = {"K0": "K0 = k + KT", "R": "R (eq. 3.5)", "D_ref": "dissipation per cycle at q_ref",
+          "dissipation_exponent": "dissipation exponent chi + 3", "KT/k": "KT/k split", "phi_max": "phi_max (eq. 3.7)"}
+
+
+def _interval(lo: float, hi: float, unit: str = "") -> str:
+    u = "" if unit in ("", "-") else f" {unit}"
+    return f"[{_g(lo)}, {_g(hi)}]{u}"
+
+
+def named_effects(diagnosis: Mapping[str, Any]) -> list[str]:
+    """The effects a diagnosis named (a list, also from a diagnosis that names one effect by its ``effect``)."""
+    if "effects" in diagnosis:
+        return [str(e) for e in diagnosis["effects"]]
+    effect = str(diagnosis.get("effect", "none"))
+    return [] if effect in ("none", "unexplained") else [effect]
+
+
+def _label(row: pd.Series) -> str:
+    name = str(row["quantity"])
+    if row["kind"] == "curve":
+        base, _, where = name.partition("(")
+        return f"{'f' if base == 'f' else 'zeta'} at q = {_g(float(row['q_in']))} in ({where.rstrip(')')})"
+    return _WORDS.get(name, name)
+
+
+def _unit(row: pd.Series) -> str:
+    return "" if row["unit"] == "-" else str(row["unit"])
+
+
+def _item1(best: Mapping, validation: Mapping | None, fit: Mapping | None) -> str:
+    kind = "the paper's model" if best.get("model_kind", "ministack") == "ministack" else "the calibrated mode"
+    parts = [] if validation is not None else ["The validation stage did not run."]
+    if validation is not None:
+        E = float(validation["E"])
+        holds = E <= HOLDS_E
+        parts.append(f"{'<b>Yes</b>' if holds else '<b>No</b>'}: {kind} against the measured envelopes, E = "
+                     f"<b>{E:.2f}</b> (1 = the repeat-to-repeat scatter): {closeness(E)}.")
+    if fit is not None and np.isfinite(fit.get("fit_p", np.nan)):
+        p = float(fit["fit_p"])
+        reject = p < P_REJECT
+        parts.append(f"Its calibrated frequencies and damping ratios {'are rejected by' if reject else 'agree with'} "
+                     f"the repeats: chi-square {_g(float(fit['fit_chi2']))} for {int(fit['fit_dof'])} degrees of "
+                     f"freedom, p = {p:.1g}{' (the model, not noise, sets the misfit)' if reject else ''}.")
+    return " ".join(parts)
+
+
+def _item2(diagnosis: Mapping | None, best: Mapping) -> str:
+    if diagnosis is None:
+        exc = best.get("excitation", "base")
+        return (f"Not run: the discrepancy library holds the base-driven rig's effects; this campaign is {exc}-driven."
+                if exc != "base" else "The discrepancy stage did not run.")
+    E0, E1 = float(diagnosis["metric_before"]), float(diagnosis["metric_after"])
+    effects = named_effects(diagnosis)
+    if effects:
+        rec = diagnosis.get("recalibrated", {})
+        pars = "; ".join(f"{html.escape(k)} {_g(v['value'])} {_interval(*v['interval_90'], v.get('unit', ''))}"
+                         for k, v in rec.get("effect_parameters", {}).items())
+        return (f"It names <b>{html.escape(' + '.join(effects))}</b> (confidence {html.escape(str(diagnosis.get('confidence')))})"
+                + (f": {pars}" if pars else "") + f". With it E goes from <b>{E0:.2f}</b> to <b>{E1:.2f}</b> "
+                f"({closeness(E1)}), checked with the time simulation driven by each run's measured base record.")
+    if diagnosis.get("effect") == "none":
+        return f"No missing effect: the paper's model predicts the levels it did not see within the scatter (E = {E0:.2f})."
+    return (f"Unexplained: no library effect closes the gap decisively (E = {E0:.2f}); "
+            + html.escape(str(diagnosis.get("outside_library") or "look for a second effect or one outside the library"))
+            + ".")
+
+
+def corrected_holds(diagnosis: Mapping | None) -> bool:
+    """An effect was named and the corrected model's E is within the scatter (`HOLDS_E`) and below the paper's."""
+    return bool(diagnosis and named_effects(diagnosis) and float(diagnosis["metric_after"]) <= HOLDS_E
+                and float(diagnosis["metric_after"]) < float(diagnosis["metric_before"]))
+
+
+def _item3(identified: pd.DataFrame, diagnosis: Mapping | None, corrected: Mapping[str, bool] | None) -> str:
+    t = identified
+    free = [str(r["quantity"]) for _, r in t.iterrows() if not r["identified"] and r["kind"] != "curve"]
+    if corrected_holds(diagnosis) and corrected is not None:
+        rec = diagnosis["recalibrated"]["joint_parameters"]  # type: ignore[index]
+        units = dict(zip(t["quantity"], t["unit"]))
+        fixed = [p for p in PARAMS if corrected.get(p) and p in rec]
+        loose = [p for p in PARAMS if not corrected.get(p)]
+        vals = "; ".join(f"{p} {_g(rec[p]['value'])} {_interval(*rec[p]['interval_90'], units.get(p, ''))}"
+                         for p in fixed)
+        spurious = [p for p in loose if p in rec and not np.isclose(*rec[p]["interval_90"])]
+        note = (f" The discrepancy stage's recalibration gives {', '.join(spurious)} intervals, but the runs' read-outs "
+                "are flat along them at the repeat scatter, so they are not quoted." if spurious else "")
+        return (f"Model that holds: the paper's with {html.escape(' + '.join(named_effects(diagnosis)))}. "  # type: ignore[arg-type]
+                f"Identified (its recalibration's values, 90% intervals): {vals or 'none of the joint parameters'}. "
+                f"Left to the bounds (no value is given): {', '.join(loose) or 'nothing'}. Its K0 = k + KT, R and "
+                "curves are not in diagnosis.json (per-parameter intervals only); the paper's model's follow below, "
+                "biased by the missing effect." + note)
+    rows = [r for _, r in t.iterrows() if r["identified"] and r["kind"] != "curve"]
+    vals = "; ".join(f"{_label(r)} {_g(r['median'])} {_interval(r['q05'], r['q95'], _unit(r))}" for r in rows)
+    curves = t[(t["kind"] == "curve") & t["identified"]]
+    cw = ""
+    f = curves[curves["quantity"].str.startswith("f(")]
+    z = curves[curves["quantity"].str.startswith("zeta(")]
+    if len(f) and len(z):
+        cw = (f" Over the measured amplitudes {_g(f['q_in'].min())} to {_g(f['q_in'].max())} in the frequency falls "
+              f"from {_g(f['median'].iloc[0])} {_interval(f['q05'].iloc[0], f['q95'].iloc[0])} to "
+              f"{_g(f['median'].iloc[-1])} {_interval(f['q05'].iloc[-1], f['q95'].iloc[-1])} Hz and the damping "
+              f"ratio rises from {_g(z['median'].iloc[0])} {_interval(z['q05'].iloc[0], z['q95'].iloc[0])} to "
+              f"{_g(z['median'].iloc[-1])} {_interval(z['q05'].iloc[-1], z['q95'].iloc[-1])}.")
+    free_words = (f" Left to the bounds (no value is given): {', '.join(_WORDS.get(n, n) for n in free)}."
+                  if free else " Every parameter is identified.")
+    return f"Identified (posterior median, 90% interval): {vals or 'nothing'}.{cw}{free_words}"
+
+
+def _item4(next_test: Mapping | None) -> str:
+    if next_test is None:
+        return "The design stage did not run."
+    r = next_test.get("recommended")
+    if not r:
+        return "<b>No level recommended.</b> " + html.escape(str(next_test.get("reason", ""))) + " " + html.escape(
+            str(next_test.get("what_would_identify", "")))
+    tg = next_test.get("targets", [])
+    head = (f"<b>{r['level_g']:g} g base sweep, {r['direction']}, at {r['sweep_rate_hz_per_s']:g} Hz/s</b> "
+            f"({r['duration_s']:.1f} s).")
+    if not tg:
+        return head + " The data identify every parameter; this test narrows the intervals most."
+    share = float(next_test["share_of_draws_identifying_targets"])
+    wn, ri = next_test["width_now"], next_test["predicted_width_ratio_if_identified"]
+    parts = [f"{n} from within a factor {10 ** wn[n]:.3g} to {10 ** (wn[n] / ri[n]):.3g} (width ratio {_g(ri[n])})"
+             for n in tg if np.isfinite(ri.get(n, np.nan))]
+    names = " and ".join(tg)
+    cond = (f"It identifies {names} at {100 * share:.0f}% of the posterior draws" if next_test.get("identifies_targets")
+            else f"No level up to the shaker limit ({next_test.get('max_level_g', float('nan')):g} g) identifies {names} at "
+            f"{100 * float(next_test.get('confidence', 0.9)):.0f}% of the posterior draws; this one does at the largest "
+            f"share, {100 * share:.0f}% (where macroslip starts below the amplitude it reaches)")
+    return (head + f" {cond}. Where it does: " + "; ".join(parts) + ". Expected width ratios (90% width now over "
+            "after) over all draws: " + ", ".join(f"{n} {_g(v)}" for n, v in next_test["predicted_width_ratio"].items())
+            + ". Predicted with the paper's model's posterior; details in 6. Next test.")
+
+
+def verdict_items(*, best: Mapping, identified: pd.DataFrame, validation: Mapping | None = None,
+                  fit: Mapping | None = None, diagnosis: Mapping | None = None, next_test: Mapping | None = None,
+                  corrected: Mapping[str, bool] | None = None) -> list[tuple[str, str]]:
+    """The four verdict items of one assembly: (question, answer as HTML).
+
+    ``corrected``: which joint parameters the runs identify at the corrected model's point
+    (`jointcal.posterior.identified.identified_at`), when the discrepancy stage named an effect.
+    """
+    return [("Does the paper's model reproduce the measured envelopes?", _item1(best, validation, fit)),
+            ("What did the discrepancy stage name, and what did the correction change?", _item2(diagnosis, best)),
+            ("What do the data identify (the model that holds)?", _item3(identified, diagnosis, corrected)),
+            ("The next test", _item4(next_test))]
+
+
+def identified_html(identified: pd.DataFrame, *, title: str) -> str:
+    """A compact table of every candidate quantity: identified ones with median and 90% interval, the others
+    named as left to the bounds (their 90% range shown as a range, not a value)."""
+    rows = [f"<p><b>{html.escape(title)}</b></p><table class='ident'><tr><th>quantity</th><th>identified?</th>"
+            "<th>posterior median [90% interval]</th><th>share of its variance along free directions</th></tr>"]
+    for _, r in identified.iterrows():
+        u = _unit(r)
+        if r["identified"]:
+            cell = f"{_g(r['median'])} {_interval(r['q05'], r['q95'], u)}"
+            flag = "<span class='good'>yes</span>"
+        else:
+            cell = (f"<i>left to the bounds</i> (posterior spans {_g(r['q05'])} to {_g(r['q95'])}"
+                    f"{' ' + u if u else ''}, set by the bounds, not the data)")
+            flag = "<span class='bad'>no</span>"
+        rows.append(f"<tr><td class='lab'>{html.escape(_label(r))}</td><td>{flag}</td><td class='lab'>{cell}</td>"
+                    f"<td>{float(r['free_share']):.2f}</td></tr>")
+    rows.append("</table>")
+    return "\n".join(rows)
+
+
+def verdict_html(items: Mapping[str, Sequence[tuple[str, str]]], *, landing: bool = False) -> str:
+    """Per assembly the four items, numbered: the summary page's opening (with the questions) or, with
+    ``landing``, the landing text's (answers only, left-aligned in Snakemake's centred landing page)."""
+    out = (['<div style="font-size:13px;line-height:1.35;text-align:left">'] if landing
+           else ["<h3>Verdict of this run</h3>"])
+    for name, its in items.items():
+        out.append(f"<div><b>{html.escape(name)}</b></div><ol style='margin-top:0'>" if landing
+                   else f"<p><b>Assembly {html.escape(name)}</b></p><ol class='verdict'>")
+        out += [f"<li>{a}</li>" if landing else f"<li><b>{html.escape(q)}</b> {a}</li>" for q, a in its]
+        out.append("</ol>")
+    return "\n".join(out + (["</div>"] if landing else [])) + "\n"

@@ -1,0 +1,43 @@
+# Stage design: which test to run next (jointcal.design), from each assembly's posterior through the
+# fast steady-state model; next_test.json/.csv/.md and a figure. Include after posterior.smk (uses
+# ASSEMBLY_RE and POSTERIOR). A force- or voltage-driven campaign gets the same files saying in words
+# what cannot be recommended.
+DESIGN = RESULTS / "design"
+
+
+rule design_assembly:
+    input:
+        runs=RESULTS / "ingest" / "runs.csv",
+        modal=RESULTS / "modal" / "modal_properties.csv",
+        scatter=RESULTS / "modal" / "scatter.csv",
+        best=RESULTS / "calibration" / "{assembly}" / "ga_best.json",
+        chain=POSTERIOR / "{assembly}" / "chain.npz",
+        identified=POSTERIOR / "{assembly}" / "identified.csv",
+    output:
+        json=DESIGN / "{assembly}" / "next_test.json",
+        csv=DESIGN / "{assembly}" / "next_test.csv",
+        markdown=report(DESIGN / "{assembly}" / "next_test.md", caption="../report/next_test_md.rst",
+                        category="6. Next test", subcategory="{assembly}"),
+        figure=report(RESULTS / "figures" / "next_test_{assembly}.png", caption="../report/next_test.rst",
+                      category="6. Next test", subcategory="{assembly}"),
+    params:
+        code=source_hash("design.py"),
+        design=config.get("design", {}),
+        calibrate=config.get("calibrate", {}),
+        posterior=config.get("posterior", {}),
+        modal=config["modal"],
+    wildcard_constraints:
+        assembly=ASSEMBLY_RE,
+    threads: 1
+    benchmark:
+        RESULTS / "benchmarks" / "design_{assembly}.tsv"
+    log:
+        RESULTS / "logs" / "design" / "{assembly}.log",
+    script:
+        "../scripts/design.py"
+
+
+rule design:
+    input:
+        expand(DESIGN / "{assembly}" / "next_test.json", assembly=ASSEMBLIES),
+        expand(RESULTS / "figures" / "next_test_{assembly}.png", assembly=ASSEMBLIES),
