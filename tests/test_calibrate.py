@@ -18,7 +18,7 @@ from _campaign import REPO
 from _modal_tables import LEVELS, M, TABLE_3_2, modal_tables, write_tables
 
 from jointcal.calibrate import (
-    PARAMS, PENALTY, CalibrateSettings, CalibrationInputError, GAOptions, ParamSpace, calibrate, objective,
+    PARAMS, PENALTY, UNITS, CalibrateSettings, CalibrationInputError, GAOptions, ParamSpace, calibrate, objective,
     predict, read_modal, run_calibration, run_ga, select_modal,
 )
 from jointcal.models import harmonic_balance, resonance_amplitude
@@ -60,6 +60,28 @@ def test_space_grows_by_named_parameters_with_their_scaling():
         SPACE.grow(["tau_s"], [0.0], [1e-4], [True])
     with pytest.raises(ValueError, match="repeat"):
         SPACE.grow(["Fs"], [1.0], [2.0], [True])
+
+
+def test_a_grown_space_reads_the_joint_by_name():
+    """Named access of a grown space: columns, the joint's six, its model and the stuck stiffness and macroslip
+    onset, against values written by hand (eq. 3.7: phi_max = Fs (1 + beta) / (KT (beta + (chi+1)/(chi+2))))."""
+    g = SPACE.grow(["gain"], [0.5], [2.0], [True], ["-"])
+    joint = {"Fs": 280.0, "KT": 1.1e6, "chi": -0.6, "beta": 0.01, "k": 7.0e5, "zeta_v": 0.002}
+    th = g.vector({**joint, "gain": 1.12})
+    assert g.units == (*(UNITS[p] for p in PARAMS), "-") and g.extra == ("gain",)
+    assert g.column(th, "gain") == 1.12 and g.named(th)["zeta_v"] == 0.002
+    np.testing.assert_array_equal(g.joint(np.stack([th, th])), [list(joint.values())] * 2)
+    assert g.stuck_stiffness(th) == pytest.approx(1.8e6, rel=1e-15)
+    c = 0.01 + 0.4 / 1.4
+    assert g.phi_max(th) == pytest.approx(280.0 * 1.01 / (1.1e6 * c), rel=1e-12)
+    stiffer = g.vector({**joint, "k": 1.4e6, "gain": 1.0})
+    model = g.model(np.stack([th, stiffer]), m=0.01)  # batched: fields (P, 1)
+    assert model.iwan.Fs.shape == (2, 1) and model.k[1, 0] == 1.4e6 and model.m == 0.01
+    assert g.model(th, m=0.01).iwan.chi == -0.6
+    with pytest.raises(ValueError, match="missing: gain"):
+        g.vector(joint)
+    with pytest.raises(KeyError, match="tau_s"):
+        g.column(th, "tau_s")
 
 
 @pytest.mark.parametrize("bounds, match", [

@@ -14,7 +14,7 @@ import pandas as pd
 from jointcal.calibrate import LOG_SCALED, PARAMS, CalibrateSettings
 from jointcal.io import write_bytes_atomic
 from jointcal.posterior import PosteriorSettings
-from jointcal.report.calibration import corner_figure
+from jointcal.report.corner import corner_figure
 from jointcal.report.summary import chain_status, ga_best_point, rst_escape
 
 

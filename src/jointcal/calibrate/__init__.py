@@ -7,7 +7,7 @@ population), `ga` (DEAP loop with stall stop and checkpoints), `fit` (GA + polis
 tables), `settings` (the ``calibrate:`` config section) and `stage` (files).
 """
 from .data import DAMPING, CalibrationInputError, ModalData, read_modal, read_table, select_modal
-from .fit import Calibration, calibrate, model_curves, polish, polish_starts
+from .fit import Calibration, calibrate, least_squares_polish, model_curves, polish, polish_starts, search
 from .ga import GAOptions, GAResult, run_ga
 from .kind import KINDS, data_bounds, excitation_of_table, kind_of, model_words
 from .objective import MODELS, PENALTY, objective, predict
@@ -20,7 +20,7 @@ __all__ = [
     "ParamSpace", "PARAMS", "UNITS", "LOG_SCALED",
     "MODELS", "PENALTY", "predict", "objective",
     "GAOptions", "GAResult", "run_ga",
-    "Calibration", "calibrate", "polish", "polish_starts", "model_curves",
+    "Calibration", "calibrate", "search", "polish", "least_squares_polish", "polish_starts", "model_curves",
     "CalibrateSettings", "DEFAULT_BOUNDS",
     "OUTPUTS", "resolve", "run_calibration",
     "KINDS", "data_bounds", "excitation_of_table", "kind_of", "model_words",

@@ -24,14 +24,13 @@ import pandas as pd
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
-from ..models import derived
 from .data import ModalData
-from .ga import GAResult, run_ga
+from .ga import GAOptions, GAResult, run_ga
 from .objective import MODELS, objective, predict
 from .settings import CalibrateSettings
-from .space import PARAMS, ParamSpace
+from .space import ParamSpace
 
-__all__ = ["Calibration", "calibrate", "model_curves", "polish", "polish_starts"]
+__all__ = ["Calibration", "calibrate", "least_squares_polish", "model_curves", "polish", "polish_starts", "search"]
 
 
 @dataclass
@@ -47,24 +46,38 @@ class Calibration:
 
 
 def _residuals(theta: NDArray[np.float64], data: ModalData, s: CalibrateSettings) -> NDArray[np.float64]:
-    """Residual vectors whose squared norms are eq. 3.9, shape (P, 2N), for parameters theta (P, 6)."""
-    f_m, z_m = predict(np.atleast_2d(theta), data.q, m=s.m, model=s.model, viscous=s.viscous)
+    """Residual vectors whose squared norms are eq. 3.9, shape (P, 2N), for parameters theta (P, n) of `s.space`."""
+    f_m, z_m = predict(s.space.joint(np.atleast_2d(theta)), data.q, m=s.m, model=s.model, viscous=s.viscous)
     n = data.q.size
     return np.concatenate([np.sqrt(s.eta / n) * (data.f - f_m) / data.f,
                            np.sqrt((1.0 - s.eta) / n) * (data.zeta - z_m) / data.zeta], axis=1)
 
 
 def polish(u0: NDArray[np.float64], data: ModalData, s: CalibrateSettings) -> NDArray[np.float64]:
-    """Refine a unit-cube point by bounded least squares on the eq. 3.9 residuals.
+    """Refine a unit-cube point by bounded least squares on the eq. 3.9 residuals (`least_squares_polish`)."""
+    return least_squares_polish(u0, lambda U: _residuals(s.space.to_physical(U), data, s))
 
-    The Jacobian is a forward difference evaluated in one vectorised model call (7 rows).
-    Returns the refined point (unit cube); `u0` if the refinement does not lower eq. 3.9.
+
+def least_squares_polish(u0: NDArray[np.float64],
+                         residuals: Callable[[NDArray[np.float64]], NDArray[np.float64]]) -> NDArray[np.float64]:
+    """Refine a unit-cube point of any space by bounded least squares.
+
+    Parameters
+    ----------
+    u0 : ndarray, shape (n,)
+        Start in the unit cube.
+    residuals : callable
+        Unit-cube points (P, n) -> residual vectors (P, m) whose squared norm is minimised.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        The refined point; `u0` if the refinement does not lower the squared norm. The
+        Jacobian is a forward difference evaluated in one vectorised call (n + 1 rows).
     """
-    space = s.space
-
     def fun_many(U):
         with np.errstate(all="ignore"):
-            r = _residuals(space.to_physical(U), data, s)
+            r = residuals(U)
         return np.where(np.isfinite(r), r, 1e5)
 
     def jac(u, h=1e-7):
@@ -95,7 +108,7 @@ def polish_starts(history: NDArray[np.float64], regime: NDArray[np.int_] | None 
 
     Parameters
     ----------
-    history : ndarray, shape (n_evals, 2 + 6)
+    history : ndarray, shape (n_evals, 2 + n)
         `GAResult.history` (generation, objective, genes).
     regime : ndarray of int, shape (n_evals,), optional
         A label per evaluation (here: how many measured amplitudes lie at or beyond
@@ -111,7 +124,7 @@ def polish_starts(history: NDArray[np.float64], regime: NDArray[np.int_] | None 
 
     Returns
     -------
-    ndarray, shape (m, 6)
+    ndarray, shape (m, n)
         Genes of the starts; the GA's best first.
     """
     finite = np.isfinite(history[:, 1])
@@ -128,7 +141,7 @@ def polish_starts(history: NDArray[np.float64], regime: NDArray[np.int_] | None 
 
 
 def model_curves(theta: NDArray[np.float64], q_range: tuple[float, float], s: CalibrateSettings) -> pd.DataFrame:
-    """Both models' f (Hz) and zeta on a log grid of amplitudes (in).
+    """Both models' f (Hz) and zeta on a log grid of amplitudes (in), for theta (n,) of `s.space`.
 
     The grid spans ``q_range`` widened by ``s.curve_widen`` on each side, with
     ``s.curve_points`` points; columns q_in, f_hz, zeta, model.
@@ -136,9 +149,41 @@ def model_curves(theta: NDArray[np.float64], q_range: tuple[float, float], s: Ca
     q = np.geomspace(q_range[0] / s.curve_widen, q_range[1] * s.curve_widen, s.curve_points)
     parts = []
     for name in MODELS:
-        f, z = predict(np.asarray(theta)[None], q, m=s.m, model=name, viscous=s.viscous)  # type: ignore[arg-type]
+        f, z = predict(s.space.joint(np.asarray(theta)[None]), q, m=s.m, model=name, viscous=s.viscous)  # type: ignore[arg-type]
         parts.append(pd.DataFrame({"q_in": q, "f_hz": f[0], "zeta": z[0], "model": name}))
     return pd.concat(parts, ignore_index=True)
+
+
+def search(batch: Callable[[NDArray[np.float64]], NDArray[np.float64]], space: ParamSpace, options: GAOptions, *,
+           free: NDArray[np.bool_] | None = None, at: NDArray[np.float64] | None = None,
+           init: NDArray[np.float64] | None = None, resume: dict[str, Any] | None = None,
+           on_checkpoint: Callable[[dict[str, Any]], None] | None = None) -> GAResult:
+    """The DEAP GA (`run_ga`) over the unit cube of any space: the joint's, or one grown by an effect's.
+
+    Parameters
+    ----------
+    batch : callable
+        Unit-cube points of the whole space (P, n) -> objective (P,), lower is better.
+    space : ParamSpace
+    options : GAOptions
+    free : ndarray of bool, shape (n,), optional
+        Columns the GA moves (default all); the others stay at `at`.
+    at : ndarray, shape (n,), optional
+        Unit-cube values of the held columns (needed when some are held).
+    init : ndarray, shape (k, n_free), optional
+        Seeded members of the initial population (free columns).
+    resume, on_checkpoint :
+        Passed to `run_ga`.
+
+    Returns
+    -------
+    GAResult
+        Genes of the free columns (`space.embed` gives the whole point).
+    """
+    if free is None or bool(np.all(free)):
+        return run_ga(batch, space.ndim, options, init=init, resume=resume, on_checkpoint=on_checkpoint)
+    return run_ga(lambda v: batch(space.embed(v, at, free)), int(np.sum(free)), options, init=init, resume=resume,
+                  on_checkpoint=on_checkpoint)
 
 
 def calibrate(data: ModalData, s: CalibrateSettings, *, resume: dict[str, Any] | None = None,
@@ -161,13 +206,13 @@ def calibrate(data: ModalData, s: CalibrateSettings, *, resume: dict[str, Any] |
     space: ParamSpace = s.space
 
     def batch(u: NDArray[np.float64]) -> NDArray[np.float64]:
-        return objective(space.to_physical(u), data.q, data.f, data.zeta, m=s.m, eta=s.eta, model=s.model,
+        return objective(space.joint(space.to_physical(u)), data.q, data.f, data.zeta, m=s.m, eta=s.eta, model=s.model,
                          viscous=s.viscous, valid=space.inside(u))
 
-    ga = run_ga(batch, space.ndim, s.ga, resume=resume, on_checkpoint=on_checkpoint)
+    ga = search(batch, space, s.ga, resume=resume, on_checkpoint=on_checkpoint)
     u_best = ga.best
     if s.n_polish > 0:
-        phi_max = derived(*space.to_physical(ga.history[:, 2:]).T[:4])[0]
+        phi_max = space.phi_max(space.to_physical(ga.evaluated))
         beyond = np.sum(data.q[None, :] >= phi_max[:, None], axis=1)  # measured amplitudes in macroslip
         starts = polish_starts(ga.history, beyond, s.n_polish)  # the GA's best comes first
         refined = np.array([polish(u, data, s) for u in starts])
@@ -176,22 +221,21 @@ def calibrate(data: ModalData, s: CalibrateSettings, *, resume: dict[str, Any] |
     value = float(batch(u_best[None])[0])
     r = _residuals(theta, data, s)[0]
     n = data.q.size
-    phi_max = float(derived(*theta[:4])[0])
-    best: dict[str, Any] = {name: float(v) for name, v in zip(PARAMS, theta)}
+    phi_max = float(space.phi_max(theta))
+    best: dict[str, Any] = space.named(theta)
     best.update(
         objective=value, objective_ga=ga.best_value, n_polish=s.n_polish, seed=s.ga.seed,
         generations=ga.generations, stop_reason=ga.stop_reason, n_evaluations=int(len(ga.history)),
         model=s.model, viscous=s.viscous, damping=data.damping, eta=s.eta, m=s.m, assembly=data.assembly,
         n_runs=n, q_min_in=float(data.q.min()), q_max_in=float(data.q.max()), phi_max_in=phi_max,
-        f0_hz=float(np.sqrt((theta[1] + theta[4]) / s.m) / (2 * np.pi)),
+        f0_hz=float(np.sqrt(space.stuck_stiffness(theta) / s.m) / (2 * np.pi)),
         rms_rel_residual_f=float(np.sqrt(np.mean((r[:n] / np.sqrt(s.eta / n)) ** 2))) if s.eta > 0 else None,
         rms_rel_residual_zeta=(float(np.sqrt(np.mean((r[n:] / np.sqrt((1 - s.eta) / n)) ** 2)))
                                if s.eta < 1 else None),
     )
-    hist = ga.history
-    history = pd.DataFrame(space.to_physical(hist[:, 2:]), columns=list(PARAMS))
-    history.insert(0, "objective", hist[:, 1])
-    history.insert(0, "generation", hist[:, 0].astype(int))
+    history = pd.DataFrame(space.to_physical(ga.evaluated), columns=list(space.names))
+    history.insert(0, "objective", ga.objectives)
+    history.insert(0, "generation", ga.generation_of)
     logbook = pd.DataFrame(list(ga.logbook))[["gen", "nevals", "min", "median", "max", "best", "sigma"]]
     curves = model_curves(theta, (float(data.q.min()), float(data.q.max())), s)
     return Calibration(best=best, ga=ga, history=history, logbook=logbook, curves=curves)

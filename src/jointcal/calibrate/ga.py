@@ -103,6 +103,21 @@ class GAResult:
     logbook: tools.Logbook
     history: NDArray[np.float64]
 
+    @property
+    def evaluated(self) -> NDArray[np.float64]:
+        """Genes of every evaluated individual (unit cube), shape (n_evals, ndim)."""
+        return self.history[:, 2:]
+
+    @property
+    def objectives(self) -> NDArray[np.float64]:
+        """Objective of every evaluated individual, shape (n_evals,)."""
+        return self.history[:, 1]
+
+    @property
+    def generation_of(self) -> NDArray[np.int_]:
+        """Generation in which each individual was evaluated, shape (n_evals,)."""
+        return self.history[:, 0].astype(int)
+
 
 def _mutate(ind: list, sigma: list[float], indpb: float) -> tuple[list]:
     (ind,) = tools.mutGaussian(ind, mu=0.0, sigma=sigma, indpb=indpb)

@@ -31,13 +31,14 @@ from .kind import KINDS
 from .objective import MODELS
 from .space import PARAMS, ParamSpace
 
-__all__ = ["DEFAULT_BOUNDS", "CalibrateSettings"]
+__all__ = ["DEFAULT_BOUNDS", "JOINT", "CalibrateSettings"]
 
 DEFAULT_BOUNDS: dict[str, list[float]] = {
     "Fs": [1.0, 1.0e4], "KT": [1.0e4, 1.0e8], "chi": [-0.95, 0.0],
     "beta": [1.0e-4, 5.0], "k": [1.0e4, 1.0e8], "zeta_v": [1.0e-4, 0.1],
 }
 _GA_KEYS = {f.name for f in fields(GAOptions)}
+JOINT = ParamSpace.from_bounds(DEFAULT_BOUNDS)  # the joint's six columns (names, units, scaling) at the defaults
 
 
 @dataclass(frozen=True)

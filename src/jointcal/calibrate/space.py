@@ -13,10 +13,16 @@ log scale gives each decade the same prior mass and GA resolution. beta below th
 is indistinguishable from 0: c = beta + (chi+1)/(chi+2) >= 0.048 for chi >= -0.95, so
 beta = 1e-4 changes c, phi_max, R and S by at most 0.2% (eqs. 3.5-3.7).
 
-The space grows by a named effect's parameters (`ParamSpace.grow`, issue 9): the
-discrepancy workflow's candidate models are the six joint columns followed by the
-effect's own, each with its bounds and scaling, and the GA and the sampler work on the
-grown unit cube unchanged.
+The space grows by a named effect's parameters (`ParamSpace.grow`): the discrepancy
+workflow's candidate models are the six joint columns followed by the effect's own, each
+with its bounds and scaling, and the GA and the sampler work on the grown unit cube
+unchanged.
+
+The space is also the one place that knows where a parameter sits in a vector: every
+other module reads a column by name (`ParamSpace.column`, `ParamSpace.joint`), builds a
+vector from names (`ParamSpace.vector`), or asks for the joint's model and derived
+quantities (`ParamSpace.iwan`, `ParamSpace.model`, `ParamSpace.stuck_stiffness`,
+`ParamSpace.phi_max`), so a grown space flows through calibrate and posterior unchanged.
 """
 from __future__ import annotations
 
@@ -25,6 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from ..models import IwanParams, MinistackModel, derived
 
 __all__ = ["PARAMS", "UNITS", "LOG_SCALED", "ParamSpace"]
 
@@ -48,14 +56,19 @@ class ParamSpace:
         Column names; default the paper's six `PARAMS`.
     log : tuple of bool, optional
         Log10 scaling per column; default `LOG_SCALED` (required for other names).
+    units : tuple of str, optional
+        Unit per column; default `UNITS` ("-" for other names).
     """
 
     lo: tuple[float, ...]
     hi: tuple[float, ...]
     names: tuple[str, ...] = PARAMS
     log: tuple[bool, ...] | None = None
+    units: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
+        if self.units is None:
+            object.__setattr__(self, "units", tuple(UNITS.get(p, "-") for p in self.names))
         if self.log is None:
             unknown = [p for p in self.names if p not in LOG_SCALED]
             if unknown:
@@ -64,7 +77,7 @@ class ParamSpace:
         n = len(self.names)
         if len(set(self.names)) != n:
             raise ValueError(f"parameter names repeat: {', '.join(self.names)}")
-        if len(self.lo) != n or len(self.hi) != n or len(self.log) != n:
+        if len(self.lo) != n or len(self.hi) != n or len(self.log) != n or len(self.units) != n:
             raise ValueError(f"bounds need {n} values each ({', '.join(self.names)}), "
                              f"got {len(self.lo)} and {len(self.hi)}")
         for name, a, b, lg in zip(self.names, self.lo, self.hi, self.log):
@@ -78,10 +91,17 @@ class ParamSpace:
                 raise ValueError(f"bounds of chi must lie in (-1, 0], got [{self.lo[chi]!r}, {self.hi[chi]!r}]")
 
     def grow(self, names: Sequence[str], lo: Sequence[float], hi: Sequence[float],
-             log: Sequence[bool]) -> ParamSpace:
-        """This space with further parameters appended (an effect's: names, bounds, scaling)."""
+             log: Sequence[bool], units: Sequence[str] | None = None) -> ParamSpace:
+        """This space with further parameters appended (an effect's: names, bounds, scaling, units ("-" if
+        not given))."""
+        units = ["-"] * len(names) if units is None else list(units)
         return ParamSpace((*self.lo, *map(float, lo)), (*self.hi, *map(float, hi)), (*self.names, *names),
-                          (*self.log, *map(bool, log)))
+                          (*self.log, *map(bool, log)), (*self.units, *units))
+
+    def grow_by(self, params: Sequence) -> ParamSpace:
+        """This space grown by parameter descriptions with ``.name .lo .hi .log .unit`` (an effect's `params`)."""
+        return self.grow([p.name for p in params], [p.lo for p in params], [p.hi for p in params],
+                         [p.log for p in params], [p.unit for p in params])
 
     @classmethod
     def from_bounds(cls, bounds: Mapping[str, ArrayLike]) -> ParamSpace:
@@ -141,3 +161,78 @@ class ParamSpace:
         """True where a point (..., n) of the unit cube lies within the bounds (and is finite)."""
         u = np.asarray(u, dtype=float)
         return np.all(np.isfinite(u) & (u >= 0.0) & (u <= 1.0), axis=-1)
+
+    # --- named access: the only place that knows where a parameter sits in a vector ---
+
+    def index(self, name: str) -> int:
+        """Column of parameter `name`."""
+        if name not in self.names:
+            raise KeyError(f"parameter {name!r} is not in the space ({', '.join(self.names)})")
+        return self.names.index(name)
+
+    @property
+    def extra(self) -> tuple[str, ...]:
+        """The parameters grown onto the joint's (an effect's), in column order."""
+        return tuple(p for p in self.names if p not in PARAMS)
+
+    def column(self, theta: ArrayLike, name: str, *, keepdims: bool = False) -> NDArray[np.float64]:
+        """Values of parameter `name` in vectors theta (..., n): shape (...) or (..., 1) with `keepdims`."""
+        i = self.index(name)
+        return np.asarray(theta, dtype=float)[..., i:i + 1] if keepdims else np.asarray(theta, dtype=float)[..., i]
+
+    def columns(self, theta: ArrayLike, names: Sequence[str]) -> NDArray[np.float64]:
+        """The columns `names` of theta (..., n), in that order: shape (..., len(names))."""
+        return np.asarray(theta, dtype=float)[..., [self.index(p) for p in names]]
+
+    def joint(self, theta: ArrayLike) -> NDArray[np.float64]:
+        """The joint's six parameters (Fs, KT, chi, beta, k, zeta_v) of theta (..., n): shape (..., 6)."""
+        return self.columns(theta, PARAMS)
+
+    def named(self, theta: ArrayLike, names: Sequence[str] | None = None, *,
+              keepdims: bool = False) -> dict[str, NDArray[np.float64] | float]:
+        """``{name: value}`` of theta: floats for one vector (n,), arrays for a batch (with `keepdims`: (P, 1))."""
+        th = np.asarray(theta, dtype=float)
+        names = self.names if names is None else names
+        if th.ndim == 1:
+            return {p: float(th[self.index(p)]) for p in names}
+        return {p: self.column(th, p, keepdims=keepdims) for p in names}
+
+    def vector(self, values: Mapping[str, float], default: Mapping[str, float] | None = None) -> NDArray[np.float64]:
+        """The vector (n,) of the values named in `values` (missing ones from `default`)."""
+        merged = {**(default or {}), **values}
+        missing = [p for p in self.names if p not in merged]
+        if missing:
+            raise ValueError(f"parameter value(s) missing: {', '.join(missing)} (the space has {', '.join(self.names)})")
+        return np.array([float(merged[p]) for p in self.names])
+
+    def iwan(self, theta: ArrayLike, *, keepdims: bool = False) -> IwanParams:
+        """The joint's Iwan element (Fs, KT, chi, beta) of theta; batched fields (P,) or (P, 1)."""
+        v = self.named(theta, ("Fs", "KT", "chi", "beta"), keepdims=keepdims)
+        return IwanParams(v["Fs"], v["KT"], v["chi"], v["beta"])
+
+    def model(self, theta: ArrayLike, m: float) -> MinistackModel:
+        """The joint's `MinistackModel` (slug mass m, lbf s^2/in) of theta (n,), or batched for theta (P, n)
+        with fields (P, 1)."""
+        batched = np.ndim(theta) == 2
+        v = self.named(theta, ("k", "zeta_v"), keepdims=batched)
+        return MinistackModel(m=m, k=v["k"], zeta_v=v["zeta_v"], iwan=self.iwan(theta, keepdims=batched))
+
+    def stuck_stiffness(self, theta: ArrayLike) -> NDArray[np.float64]:
+        """K0 = k + KT, lbf/in, of theta (..., n): the stiffness of the stuck joint."""
+        return self.column(theta, "k") + self.column(theta, "KT")
+
+    def phi_max(self, theta: ArrayLike) -> NDArray[np.float64]:
+        """phi_max (in) of theta (..., n): the slip displacement where macroslip begins (eq. 3.7)."""
+        i = self.iwan(theta)
+        return derived(i.Fs, i.KT, i.chi, i.beta)[0]
+
+    def free_mask(self, held: Sequence[str] = ()) -> NDArray[np.bool_]:
+        """True for the columns not `held` (names), shape (n,)."""
+        return np.array([p not in held for p in self.names])
+
+    def embed(self, v: ArrayLike, at: ArrayLike, free: ArrayLike) -> NDArray[np.float64]:
+        """Unit-cube points (P, n_free) of the `free` columns (mask (n,)), the others held at `at` (n,): (P, n)."""
+        v = np.atleast_2d(np.asarray(v, dtype=float))
+        u = np.repeat(np.asarray(at, dtype=float)[None], len(v), axis=0)
+        u[:, np.asarray(free, dtype=bool)] = v
+        return u

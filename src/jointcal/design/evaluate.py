@@ -21,7 +21,8 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from ..calibrate.space import PARAMS, ParamSpace
-from ..posterior.identified import fisher, quantities, unit_jacobian
+from ..posterior.fisher import fisher, unit_jacobian
+from ..posterior.identified import quantities
 from .narrowing import narrowing
 from .predict import readout
 from .settings import DesignSettings

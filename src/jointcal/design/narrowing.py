@@ -39,8 +39,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from ..calibrate.space import ParamSpace
-from ..models import derived
-from ..posterior.identified import PRIOR_PRECISION, Z90, fisher, free_share
+from ..posterior.fisher import PRIOR_PRECISION, Z90, fisher, free_share
 
 __all__ = ["CRITERION", "DEPTHS", "depth_labels", "narrowing"]
 
@@ -127,7 +126,7 @@ def narrowing(theta: NDArray[np.float64], sigma: NDArray[np.float64], info: NDAr
     r = np.where(np.isfinite(r) & (r > 0), np.maximum(r, 1.0), 1.0)
     lr = np.log(r)
     with np.errstate(invalid="ignore", divide="ignore"):
-        depth = np.where(ok, read["q_in"].to_numpy(float) / derived(*theta[:, :4].T)[0], 0.0)
+        depth = np.where(ok, read["q_in"].to_numpy(float) / space.phi_max(theta), 0.0)
     bins = np.digitize(depth, DEPTHS[1:-1])
     labels = depth_labels()
     rows = []

@@ -23,7 +23,8 @@ import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
 from ..calibrate.objective import predict
-from ..models import IwanParams, MinistackModel, derived, resonance_amplitude, steady_state
+from ..calibrate.settings import JOINT
+from ..models import resonance_amplitude, steady_state
 
 __all__ = ["READOUT_COLUMNS", "readout"]
 
@@ -67,19 +68,19 @@ def readout(theta: ArrayLike, level_g: float, direction: Literal["up", "down"], 
         sweep jumps somewhere), macroslip (q_in beyond phi_max, eq. 3.7).
     """
     th = np.atleast_2d(np.asarray(theta, dtype=float))
-    Fs, KT, chi, beta, k, zv = (th[:, i:i + 1] for i in range(6))
-    structure = MinistackModel(m=m, k=k, zeta_v=zv, iwan=IwanParams(Fs, KT, chi, beta))
+    structure = JOINT.model(th, m)
+    p = JOINT.named(th)
     f = np.linspace(f_lo_hz, f_hi_hz, n_frequencies)
     ss = steady_state(structure, f, level_g, direction=direction)
     order = np.argsort(f) if direction == "up" else np.argsort(f)[::-1]
     reached = _passes_quadrature(np.atleast_2d(ss.relative), np.atleast_2d(ss.jump), order)
-    q, _, _ = resonance_amplitude(level_g, Fs[:, 0], KT[:, 0], chi[:, 0], beta[:, 0], k[:, 0], m, zv[:, 0],
+    q, _, _ = resonance_amplitude(level_g, p["Fs"], p["KT"], p["chi"], p["beta"], p["k"], m, p["zeta_v"],
                                   viscous=viscous)  # type: ignore[arg-type]
     q = np.where(reached, q, np.nan)
     with np.errstate(all="ignore"):
         fq, zq = predict(th, np.where(reached, q, 1e-6)[:, None], m=m, model=model,  # type: ignore[arg-type]
                          viscous=viscous)  # type: ignore[arg-type]
-    phi_max = derived(th[:, 0], th[:, 1], th[:, 2], th[:, 3])[0]
+    phi_max = JOINT.phi_max(th)
     return pd.DataFrame({"q_in": q, "f_hz": np.where(reached, fq[:, 0], np.nan),
                          "zeta": np.where(reached, zq[:, 0], np.nan), "reached": reached,
                          "peak_g": np.max(np.abs(np.atleast_2d(ss.transmissibility)), axis=1) * level_g,

@@ -30,11 +30,14 @@ from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
 from ..calibrate.space import PARAMS, ParamSpace
-from ..models import IwanParams, MinistackModel, quasi_steady, swept_transmissibility
+from ..models import MinistackModel, quasi_steady, swept_transmissibility
 from .data import RunEnvelope, run_zeta
 from .library import EFFECTS, apply_effect, effects_of
 
-__all__ = ["Candidate", "Fit", "candidate", "model_at", "fit_candidate", "envelope_E", "predict", "with_transient"]
+__all__ = ["HELD", "Candidate", "Fit", "candidate", "model_at", "fit_candidate", "envelope_E", "predict",
+           "with_transient"]
+
+HELD = ("beta",)  # joint parameters the envelopes barely constrain: held at the start's value by every fit
 
 
 @dataclass(frozen=True)
@@ -62,8 +65,7 @@ class Candidate:
     @cached_property
     def grown(self) -> ParamSpace:
         """The calibration's space with the effect's parameters appended (`ParamSpace.grow`)."""
-        e = self.effect_params
-        return self.space.grow([p.name for p in e], [p.lo for p in e], [p.hi for p in e], [p.log for p in e])
+        return self.space.grow_by(self.effect_params)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -87,10 +89,8 @@ def candidate(name: str, space: ParamSpace, m: float) -> Candidate:
 def model_at(c: Candidate, theta: NDArray, row: Mapping) -> MinistackModel:
     """The model of parameter sets theta (n,) or (P, n) for the run of `row` (batched fields (P, 1))."""
     th = np.asarray(theta, dtype=float)
-    col = (lambda i: th[..., i:i + 1]) if th.ndim == 2 else (lambda i: float(th[i]))
-    base = MinistackModel(m=c.m, k=col(4), zeta_v=col(5), iwan=IwanParams(col(0), col(1), col(2), col(3)))
-    values = {p.name: col(6 + i) for i, p in enumerate(c.effect_params)}
-    return apply_effect(base, c.name, values, row)
+    values = c.grown.named(th, c.grown.extra, keepdims=th.ndim == 2)
+    return apply_effect(c.grown.model(th, c.m), c.name, values, row)
 
 
 def _first_order(c: Candidate, theta: NDArray, run: RunEnvelope) -> NDArray[np.complex128]:
@@ -119,7 +119,7 @@ def with_transient(c: Candidate, theta: NDArray, runs: Sequence[RunEnvelope]) ->
         if run.drive is None or run.t_s is None:
             out.append(replace(run, transient=None))
             continue
-        model = model_at(c, np.asarray(theta, dtype=float)[:len(c.names)], run.row)
+        model = model_at(c, theta, run.row)
         zeta = run_zeta(run.row)
         swept = swept_transmissibility(model, run.drive, run.t_s, f_res_hz=float(run.row["f_res_hz"]), zeta=zeta)
         with np.errstate(all="ignore"):
@@ -163,17 +163,15 @@ def fit_candidate(c: Candidate, runs: Sequence[RunEnvelope], theta0: NDArray, *,
                   max_nfev: int = 60, free_joint: bool = True, refresh: int = 0) -> Fit:
     """Bounded least squares of E^2 over the candidate's unit cube, from theta0 and effect start values.
 
-    theta0 : (6,) or (n,) physical start (the baseline's joint parameters; effect values
-    default to their `start`). starts : effect starts tried (the `start` value and evenly
+    theta0 : (6,) or (n,) physical start, in the candidate's column order (the joint's parameters
+    alone, or with effect values; the effect values it does not give default to their `start`). starts : effect starts tried (the `start` value and evenly
     spread points of the unit interval, for the effect parameters theta0 does not give). free_joint : False holds the joint parameters.
     refresh : times the runs' transient factor is recomputed (at theta0 first, then at each
     optimum, refitting from it); 0 keeps the runs' own factor.
     """
-    n = len(c.names)
-    th0 = np.empty(n)
-    th0[:6] = np.asarray(theta0, dtype=float)[:6]
-    for i, p in enumerate(c.effect_params):
-        th0[6 + i] = theta0[6 + i] if len(theta0) > 6 + i else p.start
+    space = c.grown
+    given = dict(zip(space.names, map(float, theta0)))  # the space's leading columns
+    th0 = space.vector(given, default={p.name: p.start for p in c.effect_params})
     if refresh:
         runs = with_transient(c, th0, runs)
         fit = fit_candidate(c, runs, th0, starts=starts, max_nfev=max_nfev, free_joint=free_joint)
@@ -183,15 +181,14 @@ def fit_candidate(c: Candidate, runs: Sequence[RunEnvelope], theta0: NDArray, *,
             fit = replace(again, n_eval=again.n_eval + fit.n_eval)
         return fit
     u0 = np.clip(c.to_unit(th0), 1e-6, 1 - 1e-6)
-    free = np.ones(n, bool) if free_joint else np.r_[np.zeros(6, bool), np.ones(n - 6, bool)]
     # beta is barely identifiable from envelopes and sits on its floor in most joints: held
-    free[PARAMS.index("beta")] = False
+    free = space.free_mask(HELD if free_joint else (*PARAMS, *HELD))
     inits = [u0]
-    new = max(6, len(theta0))  # effect parameters without a value in theta0 get spread starts
-    if n > new:
+    spread = np.array([p not in given for p in space.names])  # effect parameters without a value in theta0
+    if spread.any():
         for s in np.linspace(0.15, 0.85, max(0, starts - 1)):
             u = u0.copy()
-            u[new:] = s
+            u[spread] = s
             inits.append(u)
     h = 1e-5
     count = [0]
@@ -229,7 +226,7 @@ def fit_candidate(c: Candidate, runs: Sequence[RunEnvelope], theta0: NDArray, *,
         cov_f = np.linalg.pinv(J.T @ J * J.shape[0]) * max(2 * best.cost, 1.0)
     except np.linalg.LinAlgError:
         cov_f = np.full((J.shape[1], J.shape[1]), np.nan)
-    cov = np.zeros((n, n))
+    cov = np.zeros((space.ndim, space.ndim))
     cov[np.ix_(free, free)] = cov_f
     u = full(best.x)
     return Fit(c.name, c.to_physical(u), float(np.sqrt(2 * best.cost)), cov, count[0])

@@ -95,8 +95,9 @@ def valley_starts(history: pd.DataFrame, best: Mapping, *, n: int = 3, rel: floa
     return picks.sort_values("objective")[list(PARAMS)].head(n).to_numpy().tolist()
 
 
-def _interval(fit, c, i) -> list[float]:
-    """Approximate 90% interval of parameter i (physical units) from the unit-cube covariance."""
+def _interval(fit, c, name) -> list[float]:
+    """Approximate 90% interval of parameter `name` (physical units) from the unit-cube covariance."""
+    i = c.grown.index(name)
     sd = np.sqrt(max(fit.cov_unit[i, i], 0.0))
     u = c.to_unit(fit.theta)
     lo, hi = u.copy(), u.copy()
@@ -105,13 +106,19 @@ def _interval(fit, c, i) -> list[float]:
     return [float(c.to_physical(lo)[i]), float(c.to_physical(hi)[i])]
 
 
+def _with_joint(c, theta, joint) -> np.ndarray:
+    """Candidate c's parameters theta with the joint's replaced by `joint` (Fs, KT, chi, beta, k, zeta_v)."""
+    return c.grown.vector(dict(zip(PARAMS, map(float, joint))), default=c.grown.named(theta))
+
+
 def _candidate_json(s, space, m, ver) -> dict:
     c = candidate(s.name, space, m)
-    eff = {p.name: {"value": float(s.fit.theta[6 + i]), "unit": p.unit, "interval_90": _interval(s.fit, c, 6 + i)}
-           for i, p in enumerate(c.effect_params)}
+    values = c.grown.named(s.fit.theta)
+    eff = {p.name: {"value": values[p.name], "unit": p.unit, "interval_90": _interval(s.fit, c, p.name)}
+           for p in c.effect_params}
     return {"name": s.name, "effects": list(c.effects), "held_out_score": s.score, "E_fit": s.fit.E,
             "held_out_E_per_level": s.held_out, "effect_parameters": eff,
-            "joint_parameters": dict(zip(PARAMS, map(float, s.fit.theta[:6]))),
+            "joint_parameters": c.grown.named(s.fit.theta, PARAMS),
             "fingerprints_for": [w for e in c.effects for w in ver[e]["for"]],
             "fingerprints_against": [w for e in c.effects for w in ver[e]["against"]], "seconds": s.seconds}
 
@@ -185,7 +192,7 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
         fits = {s.name: s.fit.theta for s in scored}
         refined = score_candidates([candidate(b, space, m) for b in bases], runs, theta0, baseline=base, log=say,
                                    max_nfev=2 * settings.max_nfev,
-                                   starts={b: [fits[b]] + [np.r_[np.asarray(th, float)[:6], fits[b][6:]]
+                                   starts={b: [fits[b]] + [_with_joint(candidate(b, space, m), fits[b], th)
                                                            for th in joint_starts] for b in bases})
         better = {r.name: r for r in refined if r.fit.E < next(s for s in scored if s.name == r.name).fit.E}
         scored = [better.get(s.name, s) for s in scored]
@@ -220,9 +227,9 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     cf = candidate(final.name, space, m)
     fits = [final.fit]
     for th in joint_starts:  # the final model from the GA's other valleys too
-        start = np.r_[np.asarray(th, dtype=float)[:6], final.fit.theta[6:]]
+        start = _with_joint(cf, final.fit.theta, th)
         alt = fit_candidate(cf, runs, start, starts=1, max_nfev=2 * settings.max_nfev, refresh=1)
-        say(f"{assembly}: {final.name} refit from Fs = {th[0]:.3g} lbf: E {alt.E:.2f}")
+        say(f"{assembly}: {final.name} refit from Fs = {cf.grown.column(start, 'Fs'):.3g} lbf: E {alt.E:.2f}")
         fits.append(alt)
     rec = recalibrate(cf, runs, fits, seed=settings.seed, generations=settings.ga_generations,
                       steps=settings.posterior_steps, max_nfev=2 * settings.max_nfev)
@@ -241,22 +248,22 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     metric_after = float(v_after.error["E"])
     lap("validate_after")
     effect, confidence, time_note = confirm(effect, confidence, float(metric_before), metric_after)
-    joint_after = {p: {"value": float(final.fit.theta[i]), "interval_90": rec.interval(i)}
-                   for i, p in enumerate(PARAMS)}
+    after = cf.grown.named(final.fit.theta)
+    joint_after = {p: {"value": after[p], "interval_90": rec.interval(p)} for p in PARAMS}
     diagnosis = {
         "assembly": assembly, "effect": effect, "effects": list(effects_of(effect)) if effect not in (
             "none", "unexplained") else [], "confidence": confidence, "rule": RULE,
         "outside_library": outside,
         "fast_model_floor": floor, "time_domain_check": time_note,
         "baseline": {"held_out_score": base.score, "E_fit": base.fit.E, "held_out_E_per_level": base.held_out,
-                     "joint_parameters": dict(zip(PARAMS, map(float, base.fit.theta[:6])))},
+                     "joint_parameters": c0.grown.named(base.fit.theta, PARAMS)},
         "candidates": cand_out, "pairs_tried": pairs_tried, "fingerprints": fp,
         "metric_before": float(metric_before), "metric_after": metric_after,
         "metric_change": metric_after / metric_before - 1.0 if metric_before else None,
         "recalibrated": {"model": final.name, "joint_parameters": joint_after, "E_fit": final.fit.E,
-                         "effect_parameters": {p.name: {"value": float(final.fit.theta[6 + i]), "unit": p.unit,
-                                                        "interval_90": rec.interval(6 + i)}
-                                               for i, p in enumerate(cf.effect_params)},
+                         "effect_parameters": {p.name: {"value": after[p.name], "unit": p.unit,
+                                                        "interval_90": rec.interval(p.name)}
+                                               for p in cf.effect_params},
                          "method": (f"DEAP GA ({rec.ga_generations} generations, best E {rec.ga_best_E:.3g}) seeded "
                                     f"with {len(fits)} least-squares fits, polished; emcee {rec.steps} steps x {rec.walkers} "
                                     f"walkers, max tau {rec.tau_max:.0f} steps"

@@ -64,7 +64,7 @@ def y_to_x(y: ArrayLike, q_ref: float) -> NDArray[np.float64]:
 
 
 def log_det_dy_dx(y: ArrayLike) -> NDArray[np.float64]:
-    """ln |det dy/dx| = ln(chi + 1) for sampler points y (..., 6 or more); chi is column 2."""
-    chi = np.asarray(y, dtype=float)[..., 2]
+    """ln |det dy/dx| = ln(chi + 1) for sampler points y (..., 6) in `Y_NAMES` order."""
+    chi = np.asarray(y, dtype=float)[..., Y_NAMES.index("chi")]
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.log(chi + 1.0)

@@ -12,7 +12,7 @@ posterior spread comes from, with a local Laplace approximation at each posterio
   and damping residual over the draw's noise scales sigma_f, sigma_zeta) with respect to
   the unit-cube coordinates u of the search space (log10 of the log-scaled parameters, chi
   linear; `jointcal.calibrate.ParamSpace`), by forward differences; F_i = G_i^T G_i is the
-  data's Fisher information there (`fisher`). The uniform prior has variance 1/12 along
+  data's Fisher information there (`jointcal.posterior.fisher`). The uniform prior has variance 1/12 along
   every direction of the cube; its Gaussian stand-in adds 12 I.
 * The eigenvectors of F_i are the directions the data fix (they narrow the prior's spread
   along them below ``ratio``) and those they leave free (`fixed_directions` counts the
@@ -35,14 +35,14 @@ import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
 from ..calibrate.objective import predict
-from ..calibrate.space import PARAMS, ParamSpace
+from ..calibrate.settings import JOINT
+from ..calibrate.space import ParamSpace
 from ..models import derived, dissipation
+from .fisher import PRIOR_PRECISION, fisher, fixed_directions, free_share, unit_jacobian
 
 __all__ = ["Quantity", "quantities", "unit_jacobian", "fisher", "free_share", "fixed_directions",
            "identified_table", "identified_at", "PRIOR_PRECISION"]
 
-PRIOR_PRECISION = 12.0  # 1 / variance of a uniform distribution on [0, 1]
-Z90 = 3.2897  # width of a normal 90% interval in standard deviations
 
 
 @dataclass(frozen=True)
@@ -51,7 +51,7 @@ class Quantity:
 
     name, unit : labels; kind : 'parameter', 'combination' or 'curve'; log : judged and
     reported in log10 (a positive scale quantity); q_in : amplitude of a curve point (in),
-    NaN otherwise; fn : theta (P, 6) physical -> (P,) values.
+    NaN otherwise; fn : theta (P, n) physical, columns of the space -> (P,) values.
     """
 
     name: str
@@ -76,156 +76,37 @@ def quantities(q: ArrayLike, *, m: float, model: str = "harmonic_balance", visco
     model, viscous : str
         As the calibration (`jointcal.calibrate.predict`).
     space : ParamSpace, optional
-        For the parameters' log scaling (default the paper's six).
+        The parameters (names, units, log scaling; default the paper's six); the
+        combinations and curves read the joint's by name.
     """
     q = np.asarray(q, dtype=float)
     q_ref = float(np.exp(np.mean(np.log(q))))
-    log = dict(zip(PARAMS, space.log)) if space is not None else {p: p != "chi" for p in PARAMS}
-    units = {"Fs": "lbf", "KT": "lbf/in", "chi": "-", "beta": "-", "k": "lbf/in", "zeta_v": "-"}
-    out = [Quantity(p, units[p], "parameter", bool(log[p]), lambda t, i=i: t[:, i]) for i, p in enumerate(PARAMS)]
+    sp = JOINT if space is None else space
+
+    def iwan(t):
+        i = sp.iwan(t)
+        return i.Fs, i.KT, i.chi, i.beta
+
+    out = [Quantity(p, unit, "parameter", bool(log), lambda t, p=p: sp.column(t, p))
+           for p, unit, log in zip(sp.names, sp.units, sp.log)]
     out += [
-        Quantity("K0", "lbf/in", "combination", True, lambda t: t[:, 1] + t[:, 4]),  # stuck stiffness k + KT
-        Quantity("R", "lbf/in^(chi+2)", "combination", True, lambda t: derived(*t[:, :4].T)[1]),  # eq. 3.5
+        Quantity("K0", "lbf/in", "combination", True, sp.stuck_stiffness),  # stuck stiffness k + KT
+        Quantity("R", "lbf/in^(chi+2)", "combination", True, lambda t: derived(*iwan(t))[1]),  # eq. 3.5
         Quantity("D_ref", "lbf in", "combination", True,  # dissipation per cycle at q_ref (eqs. 3.3-3.5)
-                 lambda t: dissipation(q_ref, *t[:, :4].T), q_ref),
-        Quantity("dissipation_exponent", "-", "combination", False, lambda t: t[:, 2] + 3.0),  # D ~ q^(chi+3)
-        Quantity("KT/k", "-", "combination", True, lambda t: t[:, 1] / t[:, 4]),
-        Quantity("phi_max", "in", "combination", True, lambda t: derived(*t[:, :4].T)[0]),  # eq. 3.7
+                 lambda t: dissipation(q_ref, *iwan(t)), q_ref),
+        Quantity("dissipation_exponent", "-", "combination", False,
+                 lambda t: sp.column(t, "chi") + 3.0),  # D ~ q^(chi+3)
+        Quantity("KT/k", "-", "combination", True, lambda t: sp.column(t, "KT") / sp.column(t, "k")),
+        Quantity("phi_max", "in", "combination", True, sp.phi_max),  # eq. 3.7
     ]
     for label, qq in (("q_min", float(q.min())), ("q_ref", q_ref), ("q_max", float(q.max()))):
         for j, (name, unit) in enumerate((("f", "Hz"), ("zeta", "-"))):
             def curve(t, qq=qq, j=j):
                 with np.errstate(all="ignore"):
-                    return predict(t, np.array([qq]), m=m, model=model, viscous=viscous)[j][:, 0]  # type: ignore[arg-type]
+                    return predict(sp.joint(t), np.array([qq]), m=m, model=model,  # type: ignore[arg-type]
+                                   viscous=viscous)[j][:, 0]
             out.append(Quantity(f"{name}({label})", unit, "curve", True, curve, qq))
     return out
-
-
-def _steps(u: NDArray[np.float64], h: float) -> NDArray[np.float64]:
-    """Forward steps in the unit cube, backward where a forward step would leave it, shape (P, d)."""
-    return np.where(u + h <= 1.0, h, -h)
-
-
-def unit_jacobian(fn: Callable[[NDArray[np.float64]], NDArray[np.float64]], u: NDArray[np.float64],
-                  space: ParamSpace, *, h: float = 1e-6) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Values and forward-difference Jacobian of ``fn(theta) -> (P, k)`` in the unit cube.
-
-    Parameters
-    ----------
-    fn : callable
-        Physical parameters (P, d) -> outputs (P, k).
-    u : ndarray, shape (P, d)
-        Unit-cube points.
-    space : ParamSpace
-    h : float
-        Step in the unit cube.
-
-    Returns
-    -------
-    values : ndarray, shape (P, k)
-    jac : ndarray, shape (P, k, d)
-    """
-    u = np.atleast_2d(np.asarray(u, dtype=float))
-    P, d = u.shape
-    step = _steps(u, h)
-    pts = np.concatenate([u[:, None, :], u[:, None, :] + np.eye(d)[None] * step[:, :, None]], axis=1)
-    y = np.asarray(fn(space.to_physical(pts.reshape(-1, d))), dtype=float).reshape(P, d + 1, -1)
-    return y[:, 0], np.moveaxis((y[:, 1:] - y[:, :1]) / step[:, :, None], 1, 2)
-
-
-def fisher(theta: ArrayLike, sigma: ArrayLike, q: ArrayLike, f: ArrayLike, zeta: ArrayLike, space: ParamSpace, *,
-           m: float, model: str = "harmonic_balance", viscous: str = "dashpot",
-           h: float = 1e-6) -> NDArray[np.float64]:
-    """Fisher information of frequency and damping read-outs in the unit cube, at each draw.
-
-    The residuals are those of the likelihood (`jointcal.posterior.likelihood`): (f_i -
-    f~(q_i))/f_i over sigma_f and (zeta_i - zeta~(q_i))/zeta_i over sigma_zeta.
-
-    Parameters
-    ----------
-    theta : array_like, shape (P, 6)
-        Draws of (Fs, KT, chi, beta, k, zeta_v), physical units.
-    sigma : array_like, shape (P, 2)
-        Each draw's relative noise scales of f and zeta.
-    q, f, zeta : array_like, shape (N,) or (P, N)
-        Amplitudes (in), frequencies (Hz) and damping ratios of the read-outs: the measured
-        ones (shared) or hypothetical ones per draw.
-    space : ParamSpace
-    m : float
-        Mass, lbf s^2/in.
-    model, viscous : str
-        As the calibration.
-    h : float
-        Finite-difference step in the unit cube.
-
-    Returns
-    -------
-    ndarray, shape (P, 6, 6)
-    """
-    theta = np.atleast_2d(np.asarray(theta, dtype=float))
-    sigma = np.atleast_2d(np.asarray(sigma, dtype=float))
-    P = len(theta)
-    q, f, zeta = (np.broadcast_to(np.asarray(a, dtype=float), (P, np.shape(a)[-1])) for a in (q, f, zeta))
-    d = theta.shape[1]
-    qq = np.repeat(q, d + 1, axis=0)  # each draw's amplitudes for its d + 1 stencil points
-
-    def fn(t):
-        with np.errstate(all="ignore"):
-            fm, zm = predict(t, qq, m=m, model=model, viscous=viscous)  # type: ignore[arg-type]
-        return np.concatenate([fm, zm], axis=1)
-
-    _, jac = unit_jacobian(fn, space.to_unit(theta), space, h=h)
-    n = q.shape[1]
-    scale = np.concatenate([1.0 / (f * sigma[:, :1]), 1.0 / (zeta * sigma[:, 1:])], axis=1)  # (P, 2N)
-    G = np.where(np.isfinite(jac), jac, 0.0) * scale[:, :, None]
-    return np.einsum("pki,pkj->pij", G, G)
-
-
-def free_share(grad: NDArray[np.float64], info: NDArray[np.float64], cov: NDArray[np.float64], *,
-               ratio: float = 0.5) -> NDArray[np.float64]:
-    """Share of a quantity's posterior variance that comes from directions the data leave free, per draw.
-
-    At each draw the eigenvectors of the data's Fisher information F split the unit cube
-    into fixed directions (the data narrow the prior's spread along them below `ratio`:
-    sqrt(12 / (12 + mu)) < ratio for eigenvalue mu) and free ones. The gradient d of the
-    quantity splits accordingly, d = d_fixed + d_free. Along the fixed directions its spread
-    is what the data leave, d_fixed^T (F + 12 I)^-1 d_fixed; along the free ones, how far the
-    posterior reaches along them, d_free^T C d_free with C the posterior covariance in the
-    cube. Returns d_free^T C d_free / (both), in [0, 1] (NaN for a zero gradient).
-
-    Parameters
-    ----------
-    grad : ndarray, shape (P, d)
-        Gradient of the quantity at each draw, unit cube.
-    info : ndarray, shape (P, d, d)
-        The data's Fisher information at each draw.
-    cov : ndarray, shape (d, d)
-        Posterior covariance of the draws in the unit cube.
-    ratio : float
-        Spread ratio below which a direction counts as fixed by the data.
-    """
-    mu, V = np.linalg.eigh(info)
-    fixed = np.sqrt(PRIOR_PRECISION / (PRIOR_PRECISION + np.maximum(mu, 0.0))) < ratio  # (P, d)
-    g = np.where(np.isfinite(grad), grad, 0.0)
-    coef = np.einsum("pij,pi->pj", V, g)  # components along the eigenvectors
-    d_free = np.einsum("pij,pj->pi", V, np.where(fixed, 0.0, coef))
-    d_fix = g - d_free
-    A = info + PRIOR_PRECISION * np.eye(g.shape[-1])
-    v_fix = np.einsum("pi,pi->p", d_fix, np.linalg.solve(A, d_fix[..., None])[..., 0])
-    v_free = np.einsum("pi,ij,pj->p", d_free, cov, d_free)
-    total = v_fix + v_free
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(total > 0, v_free / total, np.nan)
-
-
-def fixed_directions(info: NDArray[np.float64], ratio: float = 0.5) -> NDArray[np.int_]:
-    """Number of directions at each draw along which the data narrow the prior's spread below `ratio`.
-
-    An eigenvalue mu of F shrinks the spread along its eigenvector to sqrt(12 / (12 + mu)) of the
-    prior's; counted when that is below `ratio`. Returns shape (P,).
-    """
-    mu = np.linalg.eigvalsh(info)
-    return np.sum(np.sqrt(PRIOR_PRECISION / (PRIOR_PRECISION + np.maximum(mu, 0.0))) < ratio, axis=-1)
 
 
 def identified_table(samples: ArrayLike, names: Sequence[str], space: ParamSpace, q: ArrayLike, f: ArrayLike,
@@ -262,7 +143,7 @@ def identified_table(samples: ArrayLike, names: Sequence[str], space: ParamSpace
     """
     col = {n: i for i, n in enumerate(names)}
     S = np.asarray(samples, dtype=float)
-    theta = S[:, [col[p] for p in PARAMS]]
+    theta = S[:, [col[p] for p in space.names]]
     sigma = S[:, [col["sigma_f"], col["sigma_zeta"]]]
     info = fisher(theta, sigma, q, f, zeta, space, m=m, model=model, viscous=viscous)
     n_fixed = float(np.median(fixed_directions(info, ratio)))
@@ -281,7 +162,7 @@ def identified_table(samples: ArrayLike, names: Sequence[str], space: ParamSpace
         phys = 10.0 ** values[:, 0] if qt.log else values[:, 0]
         q05, q50, q95 = np.nanpercentile(phys, [5, 50, 95])
         med = float(np.median(share[ok])) if ok.any() else np.nan
-        i = PARAMS.index(qt.name) if qt.kind == "parameter" else None
+        i = space.index(qt.name) if qt.kind == "parameter" else None
         rows.append(dict(quantity=qt.name, unit=qt.unit, kind=qt.kind, log=qt.log, q_in=qt.q_in, q05=q05,
                          median=q50, q95=q95, prior_lo=space.lo[i] if i is not None else np.nan,
                          prior_hi=space.hi[i] if i is not None else np.nan, free_share=med,
@@ -301,8 +182,8 @@ def identified_at(theta: ArrayLike, sigma: ArrayLike, q: ArrayLike, space: Param
 
     Parameters
     ----------
-    theta : array_like, shape (6,)
-        (Fs, KT, chi, beta, k, zeta_v), physical units.
+    theta : array_like, shape (n,)
+        The space's parameters (Fs, KT, chi, beta, k, zeta_v, any grown), physical units.
     sigma : array_like, shape (2,)
         Relative noise of frequency and damping.
     q : array_like, shape (N,)
@@ -322,11 +203,11 @@ def identified_at(theta: ArrayLike, sigma: ArrayLike, q: ArrayLike, space: Param
     th = np.atleast_2d(np.asarray(theta, dtype=float))
     q = np.asarray(q, dtype=float)
     with np.errstate(all="ignore"):
-        f, z = predict(th, q, m=m, model=model, viscous=viscous)  # type: ignore[arg-type]
+        f, z = predict(space.joint(th), q, m=m, model=model, viscous=viscous)  # type: ignore[arg-type]
     info = fisher(th, np.atleast_2d(sigma), q, f[0], z[0], space, m=m, model=model, viscous=viscous)
     cov = np.eye(th.shape[1]) / PRIOR_PRECISION
     out = {}
-    for i, p in enumerate(PARAMS):
-        share = free_share(np.eye(th.shape[1])[i][None], info, cov, ratio=ratio)
+    for p in space.names:
+        share = free_share(np.eye(th.shape[1])[space.index(p)][None], info, cov, ratio=ratio)
         out[p] = bool(share[0] < 0.5)
     return out

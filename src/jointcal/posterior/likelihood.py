@@ -4,7 +4,10 @@ The sampler moves in the coordinates y of `jointcal.posterior.coords` (log10 K0,
 log10(KT/k), chi, log10 S_ref, log10 beta, log10 zeta_v) followed by log10 sigma_f and
 log10 sigma_zeta, the relative noise scales of the measured frequency and damping
 (`LogPosterior.names`); `LogPosterior.to_x` maps a chain to the GA's space x (log10 Fs,
-log10 KT, chi, log10 beta, log10 k, log10 zeta_v, then the two noise coordinates).
+log10 KT, chi, log10 beta, log10 k, log10 zeta_v, then the two noise coordinates). The
+space may be grown (`ParamSpace.grow`): the joint's columns are found by name and mapped
+to y, any other column is sampled in x as it is (uniform prior within its bounds); the
+modal read-outs see the joint only, so a grown column is left to its prior here.
 
 Likelihood: independent Gaussians on the relative residuals,
 r_f,i = (f_i - f~(q_i))/f_i ~ N(0, sigma_f^2) and r_z,i = (zeta_i - zeta~(q_i))/zeta_i
@@ -29,10 +32,12 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..calibrate.data import ModalData
 from ..calibrate.objective import Model, predict
-from ..calibrate.space import ParamSpace
+from ..calibrate.space import PARAMS, ParamSpace
 from .coords import Y_NAMES, log_det_dy_dx, x_to_y, y_to_x
 
-__all__ = ["LogPosterior"]
+__all__ = ["NOISE", "LogPosterior", "ResidualPosterior"]
+
+NOISE = ("sigma_f", "sigma_zeta")  # the relative noise scales sampled after the space's parameters
 
 
 @dataclass(frozen=True)
@@ -44,7 +49,7 @@ class LogPosterior:
     data : ModalData
         Measured q (in), f (Hz), zeta per usable run, and the noise floors.
     space : ParamSpace
-        Bounds of the six joint parameters.
+        Bounds of the six joint parameters, and of any grown onto them.
     m : float
         Slug mass, lbf s^2/in.
     model, viscous : str
@@ -71,9 +76,18 @@ class LogPosterior:
         return float(np.exp(np.mean(np.log(self.data.q))))
 
     @property
+    def joint(self) -> list[int]:
+        """Columns of the joint's parameters (`PARAMS` order) in x and of their y coordinates."""
+        return [self.space.index(p) for p in PARAMS]
+
+    @property
     def names(self) -> tuple[str, ...]:
-        """Sampler coordinate names (y, then log10_sigma_f, log10_sigma_zeta)."""
-        return (*Y_NAMES, "log10_sigma_f", "log10_sigma_zeta")
+        """Sampler coordinate names (y in the joint's columns, x in any other, then log10_sigma_f,
+        log10_sigma_zeta)."""
+        names = list(self.space.x_names)
+        for i, y in zip(self.joint, Y_NAMES):
+            names[i] = y
+        return (*names, "log10_sigma_f", "log10_sigma_zeta")
 
     @property
     def x_names(self) -> tuple[str, ...]:
@@ -81,8 +95,13 @@ class LogPosterior:
         return (*self.space.x_names, "log10_sigma_f", "log10_sigma_zeta")
 
     @property
+    def sample_names(self) -> tuple[str, ...]:
+        """Names of the `physical` columns: the space's parameters, then sigma_f, sigma_zeta."""
+        return (*self.space.names, *NOISE)
+
+    @property
     def ndim(self) -> int:
-        """Number of sampled coordinates (8)."""
+        """Number of sampled coordinates (8 for the joint's space)."""
         return self.space.ndim + 2
 
     @property
@@ -103,23 +122,27 @@ class LogPosterior:
     def to_x(self, y: ArrayLike) -> NDArray[np.float64]:
         """Sampler points (..., ndim) to GA-space + noise coordinates (..., ndim)."""
         y = np.asarray(y, dtype=float)
-        return np.concatenate([y_to_x(y[..., :6], self.q_ref), y[..., 6:]], axis=-1)
+        x = y.copy()
+        x[..., self.joint] = y_to_x(y[..., self.joint], self.q_ref)
+        return x
 
     def to_y(self, x: ArrayLike) -> NDArray[np.float64]:
         """Inverse of `to_x`."""
         x = np.asarray(x, dtype=float)
-        return np.concatenate([x_to_y(x[..., :6], self.q_ref), x[..., 6:]], axis=-1)
+        y = x.copy()
+        y[..., self.joint] = x_to_y(x[..., self.joint], self.q_ref)
+        return y
 
     def physical(self, x: ArrayLike) -> NDArray[np.float64]:
-        """GA-space + noise coordinates (..., ndim) to (Fs, KT, chi, beta, k, zeta_v, sigma_f, sigma_zeta)."""
+        """GA-space + noise coordinates (..., ndim) to physical values (the space's names, sigma_f, sigma_zeta)."""
         x = np.asarray(x, dtype=float)
         log = np.r_[self.space.is_log, True, True]
         return np.where(log, 10.0**x, x)
 
     def residuals(self, x: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Relative residuals of f and zeta, each (W, N), at GA-space points x (W, 6 or ndim)."""
+        """Relative residuals of f and zeta, each (W, N), at GA-space points x (W, space.ndim or ndim)."""
         x = np.atleast_2d(np.asarray(x, dtype=float))
-        theta = self.physical(np.concatenate([x[:, :6], np.zeros((len(x), 2))], axis=1))[:, :6]
+        theta = self.space.joint(np.where(self.space.is_log, 10.0 ** x[:, :self.space.ndim], x[:, :self.space.ndim]))
         with np.errstate(all="ignore"):
             f_m, z_m = predict(theta, self.data.q, m=self.m, model=self.model,
                                viscous=self.viscous)  # type: ignore[arg-type]
@@ -139,6 +162,74 @@ class LogPosterior:
         with np.errstate(all="ignore"):
             lp = (-0.5 * np.sum(r_f**2, axis=1) / s_f**2 - n * np.log(s_f)
                   - 0.5 * np.sum(r_z**2, axis=1) / s_z**2 - n * np.log(s_z)
-                  - log_det_dy_dx(y[ok]))  # prior uniform in x -> density 1/(chi+1) in y
+                  - log_det_dy_dx(y[ok][:, self.joint]))  # prior uniform in x -> density 1/(chi+1) in y
         out[ok] = np.where(np.isfinite(lp), lp, -np.inf)
+        return out
+
+
+@dataclass(frozen=True)
+class ResidualPosterior:
+    """Vectorised log-posterior of any space from residuals already divided by their scatter.
+
+    Prior: uniform on the unit cube of `space` (its bounds and scaling) in the `free`
+    columns; the others are held at the unit point `at`. Likelihood: the residual vector r
+    (m,) of a parameter set has sum(r^2) = E^2 (each of the n_res entries a measured
+    quantity over its repeat scatter, divided by sqrt(n_res)), and
+
+        log L = -n_res E^2 / (2 T),  T = max(E_opt^2, 1),
+
+    the Gauss-Newton convention: a model that misses by more than the scatter gets
+    intervals as wide as its misfit (T is its squared misfit at the optimum).
+
+    Parameters
+    ----------
+    space : ParamSpace
+        The parameters sampled (e.g. the joint's grown by an effect's).
+    residuals : callable
+        Physical parameter sets (P, n) -> residual vectors (P, m).
+    n_res : int
+        Number of residuals m.
+    temperature : float
+        T above (>= 1).
+    at : ndarray, shape (n,)
+        Unit-cube values of the held columns.
+    free : ndarray of bool, shape (n,)
+        Columns sampled.
+    """
+
+    space: ParamSpace
+    residuals: object
+    n_res: int
+    temperature: float
+    at: NDArray[np.float64]
+    free: NDArray[np.bool_]
+
+    @property
+    def ndim(self) -> int:
+        """Number of sampled coordinates (the free columns)."""
+        return int(np.sum(self.free))
+
+    def unit(self, v: ArrayLike) -> NDArray[np.float64]:
+        """Sampler points (P, ndim) to unit-cube points of the whole space (P, n)."""
+        return self.space.embed(v, self.at, self.free)
+
+    def physical(self, v: ArrayLike) -> NDArray[np.float64]:
+        """Sampler points (P, ndim) to physical parameter sets (P, n) in `space.names` order."""
+        return self.space.to_physical(self.unit(v))
+
+    def misfit_unit(self, u: ArrayLike) -> NDArray[np.float64]:
+        """E^2 of unit-cube points of the whole space u (P, n), shape (P,) (a GA objective)."""
+        return np.sum(self.residuals(self.space.to_physical(u)) ** 2, axis=-1)  # type: ignore[operator]
+
+    def misfit(self, v: ArrayLike) -> NDArray[np.float64]:
+        """E^2 of sampler points v (P, ndim), shape (P,)."""
+        return self.misfit_unit(self.unit(v))
+
+    def __call__(self, v: ArrayLike) -> NDArray[np.float64]:
+        """log p(v | data) up to a constant, shape (P,); -inf outside the unit cube."""
+        v = np.atleast_2d(np.asarray(v, dtype=float))
+        inside = np.all((v >= 0.0) & (v <= 1.0), axis=1)
+        out = np.full(v.shape[0], -np.inf)
+        if inside.any():
+            out[inside] = -0.5 * self.n_res * self.misfit(v[inside]) / self.temperature
         return out

@@ -32,7 +32,7 @@ import emcee
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["ChainResult", "run_chain", "projected_steps", "random_state_arrays", "random_state_tuple"]
+__all__ = ["ChainResult", "run_chain", "sample_ball", "projected_steps", "random_state_arrays", "random_state_tuple"]
 
 
 @dataclass
@@ -208,3 +208,22 @@ def _converged(hist: list[NDArray[np.float64]], tau_factor: float, tau_rtol: flo
     tau, prev = np.asarray(tau), np.asarray(prev)
     return bool(np.all(np.isfinite(tau)) and n > tau_factor * tau.max()
                 and np.all(np.abs(tau - prev) / tau < tau_rtol))
+
+
+def sample_ball(log_prob: Callable[[NDArray[np.float64]], NDArray[np.float64]], centre: NDArray[np.float64],
+                sd: NDArray[np.float64], *, walkers: int, steps: int, seed: int) -> ChainResult:
+    """`run_chain` from a Gaussian ball in the unit cube (clipped to it), checked four times.
+
+    Parameters
+    ----------
+    log_prob : callable
+        ``log_prob(V) -> (W,)`` on unit-cube points V (W, d) (e.g. a `ResidualPosterior`).
+    centre, sd : ndarray, shape (d,)
+        Centre and per-coordinate width of the starting ball.
+    walkers, steps, seed : int
+        Ensemble size, the chain's length cap (steps; chunks of max(50, steps / 4)) and the
+        seed of the ball and of emcee.
+    """
+    rng = np.random.default_rng(seed)
+    x0 = np.clip(centre + rng.standard_normal((walkers, centre.size)) * sd, 0.0, 1.0)
+    return run_chain(log_prob, x0, seed=seed, max_steps=steps, chunk=max(50, steps // 4), stop_projected=0.0)

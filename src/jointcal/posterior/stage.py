@@ -32,25 +32,26 @@ from pathlib import Path
 
 import numpy as np
 
-from ..calibrate.data import CalibrationInputError, read_modal
+from ..calibrate.data import CalibrationInputError, ModalData, read_modal
 from ..calibrate.kind import model_words
 from ..calibrate.settings import CalibrateSettings
-from ..calibrate.space import PARAMS
 from ..io import write_bytes_atomic, write_csv_atomic
 from .likelihood import LogPosterior
 from .modes import find_modes, mode_labels, modes_text
 from .sampler import ChainResult, random_state_arrays, random_state_tuple, run_chain
 from .settings import PosteriorSettings
-from .summary import NAMES, burn_in, constraints_text, predictive_band, summarize
+from .summary import burn_in, constraints_text, predictive_band, summarize
 
-__all__ = ["OUTPUTS", "P_REJECT", "start_ball", "run_posterior", "goodness_of_fit", "fit_test"]
+__all__ = ["OUTPUTS", "OBSERVED", "P_REJECT", "start_ball", "run_posterior", "goodness_of_fit",
+           "fit_test"]
 
 OUTPUTS = ("summary.csv", "chain.npz", "constraints.txt", "predictive.csv")
 P_REJECT = 1e-3  # chi-square probability below which the data reject the model
+OBSERVED = ("Fs", "KT", "beta", "k")  # parameters whose own tau also counts in the stopping rule (y mixes them)
 
 
 def start_ball(lp: LogPosterior, theta: np.ndarray, ps: PosteriorSettings) -> np.ndarray:
-    """Walkers (n_walkers, 8) in sampler coordinates: a small ball around the GA optimum, inside the bounds."""
+    """Walkers (n_walkers, ndim) in sampler coordinates: a small ball around the GA optimum, inside the bounds."""
     x = lp.space.to_unit(theta) * (lp.space.x_hi - lp.space.x_lo) + lp.space.x_lo
     r_f, r_z = lp.residuals(x[None])
     noise = np.log10([np.sqrt(np.mean(r_f**2)), np.sqrt(np.mean(r_z**2))])
@@ -71,8 +72,8 @@ def goodness_of_fit(lp: LogPosterior, theta: np.ndarray, p_reject: float = P_REJ
     ----------
     lp : LogPosterior
         Data and noise floors (``lp.data.rel_noise``: relative scatter of f and zeta).
-    theta : ndarray, shape (6,)
-        Fs (lbf), KT (lbf/in), chi, beta, k (lbf/in), zeta_v.
+    theta : ndarray, shape (n,)
+        The optimum in `lp.space` (Fs lbf, KT lbf/in, chi, beta, k lbf/in, zeta_v, and any grown parameter).
     p_reject : float
         Chi-square probability below which the sentence says the data reject the model.
 
@@ -115,12 +116,101 @@ def _npz(arrays: dict) -> bytes:
     return buf.getvalue()
 
 
+def _read(modal_csv, scatter_csv, ga_best_json, assembly: str, cal: CalibrateSettings,
+          ps: PosteriorSettings) -> tuple[ModalData, dict, CalibrateSettings, np.ndarray, list[str]]:
+    """Step 1, read: the assembly's modal data, the calibration's optimum and the settings it was made with."""
+    data = read_modal(modal_csv, assembly, scatter_csv=scatter_csv, damping=cal.damping,  # type: ignore[arg-type]
+                      floors=dict(ps.rel_std_floor))
+    best = json.loads(Path(ga_best_json).read_text())
+    cal = cal.resolved(best)  # the model kind, mass and bounds the calibration used
+    for key in ("model", "viscous", "damping"):
+        if best.get(key) != getattr(cal, key):
+            raise CalibrationInputError(f"{ga_best_json}: it was calibrated with {key} {best.get(key)!r}, "
+                                        f"the config now says {getattr(cal, key)!r}; rerun the calibrate stage.")
+    return data, best, cal, cal.space.vector(best), list(data.notes)
+
+
+def _fingerprint(data: ModalData, theta: np.ndarray, cal: CalibrateSettings, ps: PosteriorSettings) -> str:
+    """What shapes the chain: the data, the start, the sampler's and the calibration's settings."""
+    shape = dict(theta=theta.tolist(), seed=ps.seed, walkers=ps.n_walkers, ball=ps.ball, floors=dict(ps.rel_std_floor),
+                 noise_max=(ps.noise_max["frequency"], ps.noise_max["damping"]),
+                 cal=[cal.model, cal.viscous, cal.damping, cal.m, cal.full_bounds])
+    fp = hashlib.sha256(json.dumps(shape, sort_keys=True).encode())
+    for a in (data.q, data.f, data.zeta):
+        fp.update(a.tobytes())
+    return fp.hexdigest()
+
+
+def _resume(ckpt: Path | None, fingerprint: str, notes: list[str]) -> dict | None:
+    """Step 2, decide where to start: the checkpoint's chain when it was made from the same inputs."""
+    if ckpt is None or not ckpt.is_file():
+        return None
+    try:
+        with np.load(ckpt) as z:
+            saved = {k: z[k] for k in z.files}
+    except Exception as exc:  # a damaged checkpoint only costs the time to recompute
+        notes.append(f"{ckpt}: unreadable checkpoint ({type(exc).__name__}); starting afresh")
+        return None
+    if str(saved.get("fingerprint")) != fingerprint:
+        notes.append(f"{ckpt}: checkpoint made with other data or settings; starting afresh")
+        return None
+    notes.append(f"{ckpt}: resuming the chain after {len(saved['chain'])} steps")
+    return dict(chain=saved["chain"], log_prob=saved["log_prob"], tau_history=list(saved["tau_history"]),
+                accepted=saved["accepted"], random_state=random_state_tuple(saved))
+
+
+def _arrays(lp: LogPosterior, fingerprint: str, chain, log_prob, random_state, tau_history, accepted) -> dict:
+    """The chain's arrays as chain.npz and the checkpoint store them."""
+    return dict(chain=chain, log_prob=log_prob, tau_history=np.asarray(tau_history), accepted=accepted,
+                names=np.array(lp.names), q_ref=lp.q_ref, fingerprint=np.array(fingerprint),
+                **random_state_arrays(random_state))
+
+
+def _sample(lp: LogPosterior, theta: np.ndarray, ps: PosteriorSettings, fingerprint: str, resume: dict | None,
+            ckpt: Path | None, progress: Callable[[str], None] | None) -> ChainResult:
+    """Step 3: emcee from a ball around the optimum (or the checkpoint), saved and reported after every chunk."""
+    def save(state: dict) -> None:
+        if ckpt is not None:
+            write_bytes_atomic(_npz(_arrays(lp, fingerprint, **state)), ckpt)
+        if progress is not None:
+            n, *tau = state["tau_history"][-1]
+            tmax = float(np.max(tau))
+            progress(f"posterior step {int(n)}/{ps.max_steps}: largest autocorrelation time {tmax:.0f} steps, "
+                     f"chain {n / tmax:.1f} tau (stops at {ps.tau_factor:g} tau)"
+                     + (f"; checkpoint {ckpt}" if ckpt is not None else ""))
+
+    return run_chain(lp, start_ball(lp, theta, ps), seed=ps.seed, max_steps=ps.max_steps, chunk=ps.chunk,
+                     tau_factor=ps.tau_factor, tau_rtol=ps.tau_rtol, stop_projected=ps.stop_projected,
+                     min_chunks=ps.min_chunks, observe=lambda c: lp.space.columns(lp.to_x(c), OBSERVED),
+                     resume=resume, on_chunk=None if ckpt is None and progress is None else save)
+
+
+def _chain_sentence(res: ChainResult, ps: PosteriorSettings, burn: int) -> str:
+    """One sentence on the chain: walkers, steps in units of tau, whether (and why not) it converged."""
+    tmax = float(np.max(res.tau))
+    rule = f"{ps.tau_factor:g}-tau rule"
+    if res.converged:
+        status = f"converged by the {rule}"
+    elif res.stop_reason == "projected":
+        status = (f"NOT converged: stopped early, {ps.tau_factor:g} tau would need about {res.projected_steps:.0f} "
+                  f"steps (extrapolated from the running tau) > {ps.stop_projected:g} x max_steps {ps.max_steps}"
+                  if np.isfinite(res.projected_steps) else
+                  f"NOT converged: stopped early, the chain length in units of tau stopped growing (the walkers "
+                  f"do not mix), so {ps.tau_factor:g} tau is out of reach of max_steps {ps.max_steps}")
+        status += "; treat the intervals as provisional"
+    else:
+        status = f"NOT converged: stopped at max_steps {ps.max_steps}; treat the intervals as provisional"
+    return (f"emcee: {ps.n_walkers} walkers, {res.steps} steps = {res.steps / tmax:.1f} x the largest "
+            f"autocorrelation time ({tmax:.0f} steps); {status}; burn-in {burn} steps; mean acceptance "
+            f"{np.mean(res.acceptance):.2f}.")
+
+
 def run_posterior(modal_csv: str | os.PathLike[str], scatter_csv: str | os.PathLike[str],
                   ga_best_json: str | os.PathLike[str], assembly: str, out_dir: str | os.PathLike[str],
                   cal: CalibrateSettings, ps: PosteriorSettings, *,
                   checkpoint: str | os.PathLike[str] | None = None,
                   progress: Callable[[str], None] | None = None) -> tuple[ChainResult, list[str]]:
-    """Sample one assembly's posterior and write the stage's outputs.
+    """Sample one assembly's posterior and write the stage's outputs: read, decide where to start, sample, write.
 
     Parameters
     ----------
@@ -144,106 +234,50 @@ def run_posterior(modal_csv: str | os.PathLike[str], scatter_csv: str | os.PathL
     notes : list of str
         Lines for the log (floors used, resume, convergence).
     """
-    floors = dict(ps.rel_std_floor)
-    data = read_modal(modal_csv, assembly, scatter_csv=scatter_csv, damping=cal.damping,  # type: ignore[arg-type]
-                      floors=floors)
-    notes = list(data.notes)
-    best = json.loads(Path(ga_best_json).read_text())
-    cal = cal.resolved(best)  # the model kind, mass and bounds the calibration used
-    for key in ("model", "viscous", "damping"):
-        if best.get(key) != getattr(cal, key):
-            raise CalibrationInputError(f"{ga_best_json}: it was calibrated with {key} {best.get(key)!r}, "
-                                        f"the config now says {getattr(cal, key)!r}; rerun the calibrate stage.")
-    theta = np.array([best[p] for p in PARAMS], dtype=float)
-    noise_max = (ps.noise_max["frequency"], ps.noise_max["damping"])
-    lp = LogPosterior(data, cal.space, cal.m, cal.model, cal.viscous, noise_max)
-    y0 = start_ball(lp, theta, ps)
-    shape = dict(theta=theta.tolist(), seed=ps.seed, walkers=ps.n_walkers, ball=ps.ball, floors=floors,
-                 noise_max=noise_max, cal=[cal.model, cal.viscous, cal.damping, cal.m, cal.full_bounds])
-    fp = hashlib.sha256(json.dumps(shape, sort_keys=True).encode())
-    for a in (data.q, data.f, data.zeta):
-        fp.update(a.tobytes())
-    fingerprint = fp.hexdigest()
-    resume = None
+    data, best, cal, theta, notes = _read(modal_csv, scatter_csv, ga_best_json, assembly, cal, ps)
+    lp = LogPosterior(data, cal.space, cal.m, cal.model, cal.viscous,
+                      (ps.noise_max["frequency"], ps.noise_max["damping"]))
+    fingerprint = _fingerprint(data, theta, cal, ps)
     ckpt = None if checkpoint is None else Path(checkpoint)
-    if ckpt is not None and ckpt.is_file():
-        try:
-            with np.load(ckpt) as z:
-                saved = {k: z[k] for k in z.files}
-        except Exception as exc:  # a damaged checkpoint only costs the time to recompute
-            saved = {}
-            notes.append(f"{ckpt}: unreadable checkpoint ({type(exc).__name__}); starting afresh")
-        if saved and str(saved.get("fingerprint")) == fingerprint:
-            resume = dict(chain=saved["chain"], log_prob=saved["log_prob"], tau_history=list(saved["tau_history"]),
-                          accepted=saved["accepted"], random_state=random_state_tuple(saved))
-            notes.append(f"{ckpt}: resuming the chain after {len(saved['chain'])} steps")
-        elif saved:
-            notes.append(f"{ckpt}: checkpoint made with other data or settings; starting afresh")
+    res = _sample(lp, theta, ps, fingerprint, _resume(ckpt, fingerprint, notes), ckpt, progress)
+    head, fit_line = _write(Path(out_dir), lp, res, theta, best, cal, ps, fingerprint)
+    notes += [head, fit_line,
+              f"noise floors (relative): frequency {data.rel_noise[0]:.3g}, damping {data.rel_noise[1]:.3g}"]
+    return res, notes
 
-    def arrays(chain, log_prob, random_state, tau_history, accepted) -> dict:
-        return dict(chain=chain, log_prob=log_prob, tau_history=np.asarray(tau_history), accepted=accepted,
-                    names=np.array(lp.names), q_ref=lp.q_ref, fingerprint=np.array(fingerprint),
-                    **random_state_arrays(random_state))
 
-    def save(state: dict) -> None:
-        if ckpt is not None:
-            write_bytes_atomic(_npz(arrays(**state)), ckpt)
-        if progress is not None:
-            n, *tau = state["tau_history"][-1]
-            tmax = float(np.max(tau))
-            progress(f"posterior step {int(n)}/{ps.max_steps}: largest autocorrelation time {tmax:.0f} steps, "
-                     f"chain {n / tmax:.1f} tau (stops at {ps.tau_factor:g} tau)"
-                     + (f"; checkpoint {ckpt}" if ckpt is not None else ""))
-
-    res = run_chain(lp, y0, seed=ps.seed, max_steps=ps.max_steps, chunk=ps.chunk, tau_factor=ps.tau_factor,
-                    tau_rtol=ps.tau_rtol, stop_projected=ps.stop_projected, min_chunks=ps.min_chunks,
-                    observe=lambda c: lp.to_x(c)[..., [0, 1, 3, 4]], resume=resume,
-                    on_chunk=None if ckpt is None and progress is None else save)
+def _write(out: Path, lp: LogPosterior, res: ChainResult, theta: np.ndarray, best: dict, cal: CalibrateSettings,
+           ps: PosteriorSettings, fingerprint: str) -> tuple[str, str]:
+    """Step 4, write: summary.csv, chain.npz (with the draws and their modes), constraints.txt, predictive.csv."""
+    space, data = lp.space, lp.data
     chain_x = lp.to_x(res.chain)
     burn = burn_in(res.tau, res.steps, ps.burn_tau)
-    summary = summarize(chain_x, lp.lower, lp.upper, burn=burn, ratio=ps.constrained_ratio)
+    summary = summarize(chain_x, lp.lower, lp.upper, burn=burn, ratio=ps.constrained_ratio, space=space)
     kept = chain_x[burn:].reshape(-1, lp.ndim)
     labels = mode_labels(kept, seed=ps.seed)  # in x: log10 of the scale parameters
-    modes = find_modes(lp.physical(kept), NAMES, labels=labels)
+    modes = find_modes(lp.physical(kept), lp.sample_names, labels=labels)
     # draws spread over steps and walkers alike (an even stride through the flattened chain can alias with the
     # number of walkers and keep only a few of them)
     pick = np.sort(np.random.default_rng(ps.seed).choice(len(kept), min(ps.predictive_draws, len(kept)),
                                                          replace=False))
     samples = lp.physical(kept[pick])
     q = np.geomspace(data.q.min() / cal.curve_widen, data.q.max() * cal.curve_widen, cal.curve_points)
-    band = predictive_band(samples[:, :6], q, m=cal.m, model=cal.model, viscous=cal.viscous)
-    tmax = float(np.max(res.tau))
-    if res.converged:
-        status = "converged by the 50-tau rule"
-    elif res.stop_reason == "projected":
-        status = (f"NOT converged: stopped early, 50 tau would need about {res.projected_steps:.0f} steps "
-                  f"(extrapolated from the running tau) > {ps.stop_projected:g} x max_steps {ps.max_steps}"
-                  if np.isfinite(res.projected_steps) else
-                  f"NOT converged: stopped early, the chain length in units of tau stopped growing (the walkers "
-                  f"do not mix), so 50 tau is out of reach of max_steps {ps.max_steps}")
-        status += "; treat the intervals as provisional"
-    else:
-        status = f"NOT converged: stopped at max_steps {ps.max_steps}; treat the intervals as provisional"
-    head = (f"emcee: {ps.n_walkers} walkers, {res.steps} steps = {res.steps / tmax:.1f} x the largest "
-            f"autocorrelation time ({tmax:.0f} steps); {status}; burn-in {burn} steps; mean acceptance "
-            f"{np.mean(res.acceptance):.2f}.")
+    band = predictive_band(space.joint(samples), q, m=cal.m, model=cal.model, viscous=cal.viscous)
+    head = _chain_sentence(res, ps, burn)
     fit_ratio, fit_line = goodness_of_fit(lp, theta)
-    text = (head + "\n" + fit_line + "\n" + modes_text(modes, PARAMS, converged=res.converged) + "\n"
-            + constraints_text(summary, chain_x, burn=burn, q_max=float(data.q.max()), ratio=ps.constrained_ratio))
+    text = (head + "\n" + fit_line + "\n" + modes_text(modes, space.names, converged=res.converged) + "\n"
+            + constraints_text(summary, chain_x, burn=burn, q_max=float(data.q.max()), ratio=ps.constrained_ratio,
+                               space=space))
     if cal.model_kind == "modal":  # what the numbers mean: per unit modal mass, the rig's mode for a voltage
         text = text.rstrip("\n") + "\n" + model_words(best) + "\n"
-    out = Path(out_dir)
     write_csv_atomic(summary, out / "summary.csv")
-    final = arrays(res.chain, res.log_prob, res.random_state, res.tau_history, res.acceptance * res.steps)
-    final.update(samples=samples, sample_names=np.array(NAMES), burn=burn, converged=res.converged,
+    final = _arrays(lp, fingerprint, res.chain, res.log_prob, res.random_state, res.tau_history,
+                    res.acceptance * res.steps)
+    final.update(samples=samples, sample_names=np.array(lp.sample_names), burn=burn, converged=res.converged,
                  stop_reason=np.array(res.stop_reason), projected_steps=res.projected_steps,
                  sample_mode=labels[pick], fit_ratio=np.asarray(fit_ratio), **fit_test(lp, theta))
     write_bytes_atomic(_npz(final), out / "chain.npz")
-    (out / "constraints.txt").parent.mkdir(parents=True, exist_ok=True)
+    out.mkdir(parents=True, exist_ok=True)
     write_bytes_atomic(text.encode(), out / "constraints.txt")
     write_csv_atomic(band, out / "predictive.csv")
-    notes.append(head)
-    notes.append(fit_line)
-    notes.append(f"noise floors (relative): frequency {data.rel_noise[0]:.3g}, damping {data.rel_noise[1]:.3g}")
-    return res, notes
-
+    return head, fit_line

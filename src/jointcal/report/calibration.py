@@ -5,8 +5,7 @@
 * `exploration_figure` -- Figs. 3.9/3.10: scatter-plot matrix of every individual the GA
   evaluated, coloured by objective, with densities on the diagonal;
 * `convergence_figure` -- best and median objective per generation;
-* `corner_figure` -- posterior pairs (2-D histograms) and marginals, written here
-  (no ``corner`` package).
+* the posterior's corner plot is `jointcal.report.corner.corner_figure`.
 
 Each returns the PNG as bytes; the workflow scripts write them with
 `jointcal.io.write_bytes_atomic`.
@@ -14,7 +13,7 @@ Each returns the PNG as bytes; the workflow scripts write them with
 from __future__ import annotations
 
 import io
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
@@ -23,7 +22,7 @@ from numpy.typing import NDArray
 from ..calibrate.space import LOG_SCALED, PARAMS
 from .summary import fmt
 
-__all__ = ["amplitude_figure", "exploration_figure", "convergence_figure", "corner_figure"]
+__all__ = ["amplitude_figure", "exploration_figure", "convergence_figure"]
 
 
 def _figure(width: float, height: float, dpi: float = 110):
@@ -197,137 +196,4 @@ def convergence_figure(logbooks: Mapping[str, pd.DataFrame]) -> bytes:
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    return _png(fig)
-
-
-def corner_figure(samples: NDArray[np.float64], names: Sequence[str], *, truth: Sequence[float] | None = None,
-                  title: str = "", bins: int = 30, points: Mapping[str, Sequence[float]] | None = None,
-                  bounds: tuple[Sequence[float], Sequence[float]] | None = None,
-                  modes: NDArray[np.int_] | None = None, stamp: tuple[str, bool] | None = None) -> bytes:
-    """Corner plot: 1-D marginals on the diagonal, 2-D histograms below it.
-
-    Parameters
-    ----------
-    samples : ndarray, shape (S, D)
-        Posterior draws in the coordinates to plot (e.g. log10 of scale parameters).
-    names : sequence of str, length D
-        Axis labels.
-    truth : sequence of float, optional
-        Reference values drawn as red lines (e.g. a synthetic campaign's truth); NaN
-        entries are skipped.
-    title : str
-        Figure title.
-    bins : int
-        Histogram bins per axis.
-    points : mapping label -> sequence of float (D,), optional
-        "GA best" and "polished optimum" (or others) in the plotted coordinates: markers
-        off the diagonal, lines on it (NaN entries skipped).
-    bounds : (lower, upper), optional
-        Prior bounds (D,) in the plotted coordinates: dashed grey lines, and a parameter
-        whose 90% interval touches one is named in the stamp.
-    modes : ndarray of int, shape (S,), optional
-        Mode label of each draw (`jointcal.posterior.mode_labels`): with two or more
-        modes, each mode's median is drawn on the diagonal (its own colour) instead of
-        the overall median, which lies between them.
-    stamp : (text, ok), optional
-        Status written on the figure (green when ok, red otherwise), e.g.
-        ("NOT converged: 12.9 tau", False).
-    """
-    samples = np.asarray(samples, dtype=float)
-    d = samples.shape[1]
-    fig = _figure(1.2 * d + 0.4, 1.2 * d, dpi=88)  # <= ~850 px tall: Snakemake's report clips taller images
-    axes = fig.subplots(d, d)
-    lims = [np.percentile(samples[:, i], [0.5, 99.5]) for i in range(d)]
-    lims = [(a, b) if b > a else (a - 0.5, a + 0.5) for a, b in lims]
-    ref = [np.nan] * d if truth is None else [float(v) for v in truth]
-    lims = [(min(a, t), max(b, t)) if np.isfinite(t) else (a, b) for (a, b), t in zip(lims, ref)]
-    pts = {k: np.asarray(v, dtype=float) for k, v in (points or {}).items()}
-    for v in pts.values():
-        lims = [(min(a, t), max(b, t)) if np.isfinite(t) else (a, b) for (a, b), t in zip(lims, v)]
-    lims = [(a - 0.03 * (b - a), b + 0.03 * (b - a)) for a, b in lims]
-    lo_b, hi_b = (np.full(d, np.nan), np.full(d, np.nan)) if bounds is None else (np.asarray(bounds[0], float),
-                                                                                  np.asarray(bounds[1], float))
-    n_modes = 0 if modes is None else int(np.max(modes)) + 1
-    styles = {k: _POINTS.get(k, dict(marker="o", color="C2")) for k in pts}
-    for i in range(d):
-        for j in range(d):
-            ax = axes[i, j]
-            if j > i:
-                ax.set_visible(False)
-                continue
-            if i == j:
-                ax.hist(samples[:, i], bins=bins, range=lims[i], histtype="step", color="k")
-                q = np.percentile(samples[:, i], [5, 50, 95])
-                if n_modes > 1:
-                    ax.axvline(q[0], color="C0", ls=":", lw=0.8)
-                    ax.axvline(q[2], color="C0", ls=":", lw=0.8)
-                    for k in range(n_modes):
-                        ax.axvline(np.median(samples[modes == k, i]), color=f"C{4 + k}", lw=1.2)
-                else:
-                    for v, ls in zip(q, (":", "-", ":")):
-                        ax.axvline(v, color="C0", ls=ls, lw=0.8)
-                for k, v in pts.items():
-                    if np.isfinite(v[i]):
-                        ax.axvline(v[i], color=styles[k]["color"], ls=styles[k].get("ls", "-"), lw=1.2)
-                ax.set_yticks([])
-            else:
-                ax.hist2d(samples[:, j], samples[:, i], bins=bins, range=[lims[j], lims[i]], cmap="Greys")
-                if np.isfinite(ref[i]):
-                    ax.axhline(ref[i], color="C3", lw=0.8)
-                for k, v in pts.items():
-                    if np.isfinite(v[i]) and np.isfinite(v[j]):
-                        st = styles[k]
-                        ax.plot(v[j], v[i], st["marker"], color=st["color"], mfc="none" if st.get("open") else
-                                st["color"], ms=8, mew=1.5)
-                for b in (lo_b[i], hi_b[i]):
-                    if np.isfinite(b) and lims[i][0] <= b <= lims[i][1]:
-                        ax.axhline(b, color="0.4", ls="--", lw=0.9)
-            for b in (lo_b[j], hi_b[j]):
-                if np.isfinite(b) and lims[j][0] <= b <= lims[j][1]:
-                    ax.axvline(b, color="0.4", ls="--", lw=0.9)
-            if np.isfinite(ref[j]):
-                ax.axvline(ref[j], color="C3", lw=0.8)
-            ax.set_xlim(*lims[j])
-            if i != j:
-                ax.set_ylim(*lims[i])
-            ax.tick_params(labelsize=8)
-            if i == d - 1:
-                ax.set_xlabel(names[j], fontsize=9)
-            else:
-                ax.set_xticklabels([])
-            if j == 0 and i > 0:
-                ax.set_ylabel(names[i], fontsize=9)
-            elif j != i:
-                ax.set_yticklabels([])
-    from matplotlib.lines import Line2D
-
-    handles = [Line2D([], [], color="C0", ls=":", label="90% interval")]
-    if n_modes > 1:
-        handles += [Line2D([], [], color=f"C{4 + k}", label=f"median of mode {k + 1} "
-                           f"({100 * np.mean(modes == k):.0f}% of draws)") for k in range(n_modes)]
-    else:
-        handles.append(Line2D([], [], color="C0", label="median"))
-    for k, st in styles.items():
-        handles.append(Line2D([], [], marker=st["marker"], color=st["color"], ls=st.get("ls", "-"),
-                              mfc="none" if st.get("open") else st["color"], label=k))
-    if bounds is not None:
-        handles.append(Line2D([], [], color="0.4", ls="--", label="prior bound"))
-    fig.legend(handles=handles, loc="upper right", bbox_to_anchor=(0.99, 0.82), fontsize=9, frameon=False)
-    lines = []
-    if stamp is not None:
-        lines.append((stamp[0], "darkgreen" if stamp[1] else "#b00000"))
-    if n_modes > 1:
-        lines.append((f"MULTIMODAL: {n_modes} separated modes (the overall median lies between them)", "#b00000"))
-    if bounds is not None:
-        q05, q95 = np.percentile(samples, [5, 95], axis=0)
-        w = hi_b - lo_b
-        at = [names[i] for i in range(d) if np.isfinite(w[i]) and (q05[i] - lo_b[i] < 0.01 * w[i]
-                                                                      or hi_b[i] - q95[i] < 0.01 * w[i])]
-        if at:
-            lines.append(("at a prior bound: " + ", ".join(at), "#b36b00"))
-    for k, (text, colour) in enumerate(lines):
-        fig.text(0.99, 0.975 - 0.035 * k, text, ha="right", va="top", fontsize=11, color=colour, weight="bold")
-    if title:
-        fig.suptitle(title, fontsize=12, x=0.02, ha="left")
-    fig.tight_layout(rect=(0, 0, 1, 0.97))
     return _png(fig)

@@ -5,7 +5,7 @@ to tidy tables and a markdown rendering.
 """
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pandas as pd
@@ -18,7 +18,8 @@ __all__ = ["table_3_2", "table_3_2_markdown", "qsma_vs_harmonic_balance"]
 
 
 def table_3_2(ga_best: Mapping[str, Mapping], summaries: Mapping[str, pd.DataFrame],
-              identified: Mapping[str, pd.DataFrame] | None = None) -> pd.DataFrame:
+              identified: Mapping[str, pd.DataFrame] | None = None, *,
+              params: Sequence[str] = PARAMS) -> pd.DataFrame:
     """Table 3.2: per assembly and parameter, the GA optimum and the posterior median [q05, q95].
 
     Parameters
@@ -30,6 +31,9 @@ def table_3_2(ga_best: Mapping[str, Mapping], summaries: Mapping[str, pd.DataFra
     identified : mapping assembly -> DataFrame, optional
         Each ``identified.csv`` (`jointcal.posterior.identified`): which parameters the data
         identify (column identified; None where not given).
+    params : sequence of str
+        The parameters tabulated: the joint's six, or a grown space's names (their units
+        from ``summary.csv``).
 
     Returns
     -------
@@ -42,9 +46,10 @@ def table_3_2(ga_best: Mapping[str, Mapping], summaries: Mapping[str, pd.DataFra
         s = summaries.get(name)
         s = s.set_index("param") if s is not None else None
         ident = None if not identified or name not in identified else identified[name].set_index("quantity")
-        for p in PARAMS:
+        for p in params:
             post = s.loc[p] if s is not None and p in s.index else None
-            rows.append(dict(assembly=name, param=p, unit=UNITS[p], ga_optimum=float(best[p]),
+            unit = UNITS[p] if p in UNITS else "-" if post is None else str(post["unit"])
+            rows.append(dict(assembly=name, param=p, unit=unit, ga_optimum=float(best[p]),
                              posterior_median=np.nan if post is None else float(post["median"]),
                              posterior_q05=np.nan if post is None else float(post["q05"]),
                              posterior_q95=np.nan if post is None else float(post["q95"]),
@@ -79,20 +84,22 @@ def table_3_2_markdown(table: pd.DataFrame) -> str:
     identified" with the range the bounds leave it, in every row: the GA optimum is given
     for the identified parameters only, as one member of the posterior's set.
     """
-    head = "| assembly | estimate | " + " | ".join(f"{p} ({UNITS[p]})" for p in PARAMS) + " |"
-    lines = [head, "|" + "---|" * (len(PARAMS) + 2)]
+    units = dict(zip(table["param"], table["unit"]))  # the table's parameters, in its order
+    params = list(units)
+    head = "| assembly | estimate | " + " | ".join(f"{p} ({units[p]})" for p in params) + " |"
+    lines = [head, "|" + "---|" * (len(params) + 2)]
     for name, g in table.groupby("assembly", sort=False):
         g = g.set_index("param")
-        free = {p: _free(g.loc[p]) for p in PARAMS}
+        free = {p: _free(g.loc[p]) for p in params}
         cells = []
-        for p in PARAMS:
+        for p in params:
             r = g.loc[p]
             cells.append(f"not identified (spans {_g(r['posterior_q05'])} to {_g(r['posterior_q95'])})" if free[p] else
                          f"{_g(r['posterior_median'])} [{_g(r['posterior_q05'])}, {_g(r['posterior_q95'])}]")
         lines.append(f"| {name} | posterior median [q05, q95] | " + " | ".join(cells) + " |")
         member = ["-" if free[p] else _g(g.loc[p, "ga_optimum"])
                   if g.loc[p, "posterior_q05"] <= g.loc[p, "ga_optimum"] <= g.loc[p, "posterior_q95"]
-                  or not np.isfinite(g.loc[p, "posterior_q05"]) else "outside the 90% interval" for p in PARAMS]
+                  or not np.isfinite(g.loc[p, "posterior_q05"]) else "outside the 90% interval" for p in params]
         lines.append(f"| {name} | GA optimum (one member of the posterior's set) | " + " | ".join(member) + " |")
     lines.append("")
     lines.append("Not identified: the data leave the parameter to the bounds; no value of it is given, only the range "

@@ -10,17 +10,16 @@ dashpot's ratio at omega is zeta_dashpot omega_0 / omega.
 """
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..calibrate.space import PARAMS as _KEYS
 from ..models import IwanParams, MinistackModel
 
 __all__ = ["model_from_params", "model_from_best", "models_from_samples"]
-
-_KEYS = ("Fs", "KT", "chi", "beta", "k", "zeta_v")
 
 
 def model_from_params(params: Mapping[str, float], m: float, *, viscous: str = "dashpot",
@@ -47,7 +46,7 @@ def model_from_params(params: Mapping[str, float], m: float, *, viscous: str = "
         if f_ref_hz is None or not f_ref_hz > 0:
             raise ValueError("a model calibrated with viscous 'constant' needs a reference frequency f_ref_hz > 0 "
                              "(the measured resonance) to become a dashpot.")
-        f0 = np.sqrt((p["k"] + p["KT"]) / m) / (2 * np.pi)
+        f0 = np.sqrt((p["k"] + p["KT"]) / m) / (2 * np.pi)  # the stuck joint's frequency
         zeta_v = zeta_v * f_ref_hz / f0
     elif viscous != "dashpot":
         raise ValueError(f"viscous must be 'dashpot' or 'constant', got {viscous!r}.")
@@ -65,25 +64,32 @@ def model_from_best(best: Mapping[str, Any], *, f_ref_hz: float | None = None) -
 
 
 def models_from_samples(samples: ArrayLike, m: float, n_draws: int, rng: np.random.Generator, *,
-                        viscous: str = "dashpot", f_ref_hz: float | None = None) -> list[MinistackModel]:
+                        viscous: str = "dashpot", f_ref_hz: float | None = None,
+                        names: Sequence[str] = _KEYS) -> list[MinistackModel]:
     """`n_draws` models drawn without replacement from posterior samples.
 
     Parameters
     ----------
     samples : array_like, shape (S, >= 6)
-        Posterior draws of (Fs, KT, chi, beta, k, zeta_v[, sigma_f, sigma_zeta]) in
-        physical units (``chain.npz`` key ``samples``).
+        Posterior draws in physical units (``chain.npz`` key ``samples``), columns named by
+        `names`: the joint's six (Fs, KT, chi, beta, k, zeta_v) among them.
     m : float
         Slug mass, lbf s^2/in.
     n_draws : int
         Models wanted (all samples if fewer).
     rng : numpy.random.Generator
         Picks the draws.
+    names : sequence of str
+        Names of the leading columns of `samples` (``chain.npz`` key ``sample_names``);
+        default the joint's six.
     """
     s = np.asarray(samples, dtype=float)
-    if s.ndim != 2 or s.shape[1] < 6:
-        raise ValueError(f"posterior samples must have shape (draws, >= 6), got {s.shape}.")
-    s = s[np.all(np.isfinite(s[:, :6]), axis=1)]
+    names = [str(p) for p in names]
+    if s.ndim != 2 or s.shape[1] < len(names) or not set(_KEYS) <= set(names):
+        raise ValueError(f"posterior samples must have shape (draws, >= {len(names)}) with columns "
+                         f"{', '.join(_KEYS)} among {', '.join(names)}, got shape {s.shape}.")
+    s = s[:, [names.index(p) for p in _KEYS]]
+    s = s[np.all(np.isfinite(s), axis=1)]
     pick = rng.choice(len(s), size=min(int(n_draws), len(s)), replace=False) if len(s) else []
-    return [model_from_params(dict(zip(_KEYS, s[i, :6])), m, viscous=viscous, f_ref_hz=f_ref_hz)
+    return [model_from_params(dict(zip(_KEYS, s[i])), m, viscous=viscous, f_ref_hz=f_ref_hz)
             for i in np.sort(pick)]
