@@ -59,20 +59,10 @@ def corner_figure(samples: NDArray[np.float64], names: Sequence[str], *, truth: 
                                                                                   np.asarray(bounds[1], float))
     n_modes = 0 if modes is None else int(np.max(modes)) + 1
     styles = {k: _POINTS.get(k, dict(marker="o", color="C2")) for k in pts}
-    for i in range(d):
-        for j in range(d):
-            ax = axes[i, j]
-            if j > i:
-                ax.set_visible(False)
-                continue
-            if i == j:
-                _marginal(ax, samples[:, i], lims[i], bins, modes if n_modes > 1 else None,
-                          {k: v[i] for k, v in pts.items()}, styles)
-            else:
-                ax.hist2d(samples[:, j], samples[:, i], bins=bins, range=[lims[j], lims[i]], cmap="Greys")
-                _pair_marks(ax, (ref[i], lo_b[i], hi_b[i]), lims[i], {k: (v[j], v[i]) for k, v in pts.items()},
-                            styles)
-            _frame(ax, (i, j, d), lims, (ref[j], lo_b[j], hi_b[j]), names)
+    marks = np.stack([ref, lo_b, hi_b], axis=1)  # per column: truth, lower and upper bound
+    for i, j in ((i, j) for i in range(d) for j in range(d)):
+        _panel(axes[i, j], samples, (i, j), lims, bins, modes if n_modes > 1 else None, pts, styles, marks,
+               names)
     fig.legend(handles=_corner_handles(styles, modes, n_modes, bounds is not None), loc="upper right",
                bbox_to_anchor=(0.99, 0.82), fontsize=9, frameon=False)
     _corner_stamps(fig, samples, names, stamp, n_modes, (lo_b, hi_b) if bounds is not None else None)
@@ -89,6 +79,22 @@ def _corner_limits(samples: NDArray[np.float64], marks: Sequence[NDArray[np.floa
     for v in marks:
         lims = [(min(a, t), max(b, t)) if np.isfinite(t) else (a, b) for (a, b), t in zip(lims, v)]
     return [(a - 0.03 * (b - a), b + 0.03 * (b - a)) for a, b in lims]
+
+
+def _panel(ax, samples: NDArray[np.float64], where: tuple[int, int], lims: Sequence[tuple[float, float]], bins: int,
+           modes: NDArray[np.int_] | None, pts: Mapping[str, NDArray[np.float64]], styles: Mapping[str, dict],
+           marks: NDArray[np.float64], names: Sequence[str]) -> None:
+    """Panel (row i, column j): hidden above the diagonal, a marginal on it, a 2-D histogram below it."""
+    i, j = where
+    if j > i:
+        ax.set_visible(False)
+        return
+    if i == j:
+        _marginal(ax, samples[:, i], lims[i], bins, modes, {k: v[i] for k, v in pts.items()}, styles)
+    else:
+        ax.hist2d(samples[:, j], samples[:, i], bins=bins, range=[lims[j], lims[i]], cmap="Greys")
+        _pair_marks(ax, tuple(marks[i]), lims[i], {k: (v[j], v[i]) for k, v in pts.items()}, styles)
+    _frame(ax, (i, j, samples.shape[1]), lims, tuple(marks[j]), names)
 
 
 def _marginal(ax, x: NDArray[np.float64], lim: tuple[float, float], bins: int, modes: NDArray[np.int_] | None,
