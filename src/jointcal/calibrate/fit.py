@@ -149,7 +149,8 @@ def model_curves(theta: NDArray[np.float64], q_range: tuple[float, float], s: Ca
     q = np.geomspace(q_range[0] / s.curve_widen, q_range[1] * s.curve_widen, s.curve_points)
     parts = []
     for name in MODELS:
-        f, z = predict(s.space.joint(np.asarray(theta)[None]), q, m=s.m, model=name, viscous=s.viscous)  # type: ignore[arg-type]
+        f, z = predict(s.space.joint(np.asarray(theta)[None]), q, m=s.m, model=name,  # type: ignore[arg-type]
+                       viscous=s.viscous)
         parts.append(pd.DataFrame({"q_in": q, "f_hz": f[0], "zeta": z[0], "model": name}))
     return pd.concat(parts, ignore_index=True)
 

@@ -59,10 +59,10 @@ def predict(theta: ArrayLike, q: ArrayLike, *, m: float, model: Model = "harmoni
     theta = np.atleast_2d(np.asarray(theta, dtype=float))
     if theta.shape[-1] != len(PARAMS):
         raise ValueError(f"theta must have {len(PARAMS)} columns ({', '.join(PARAMS)}), got shape {theta.shape}")
-    cols = [theta[:, i:i + 1] for i in range(len(PARAMS))]
-    Fs, KT, chi, beta, k, zeta_v = cols
+    v = dict(zip(PARAMS, np.split(theta, len(PARAMS), axis=1)))  # the joint's columns by name, (P, 1) each
     fn = MODELS[model]
-    return fn(np.asarray(q, dtype=float), Fs, KT, chi, beta, k, m, zeta_v, viscous=viscous)  # type: ignore[operator]
+    return fn(np.asarray(q, dtype=float), v["Fs"], v["KT"], v["chi"], v["beta"], v["k"], m,  # type: ignore[operator]
+              v["zeta_v"], viscous=viscous)
 
 
 def objective(theta: ArrayLike, q: ArrayLike, f: ArrayLike, zeta: ArrayLike, *, m: float, eta: float = 0.85,

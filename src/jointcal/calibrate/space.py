@@ -202,7 +202,8 @@ class ParamSpace:
         merged = {**(default or {}), **values}
         missing = [p for p in self.names if p not in merged]
         if missing:
-            raise ValueError(f"parameter value(s) missing: {', '.join(missing)} (the space has {', '.join(self.names)})")
+            raise ValueError(f"parameter value(s) missing: {', '.join(missing)} "
+                             f"(the space has {', '.join(self.names)})")
         return np.array([float(merged[p]) for p in self.names])
 
     def iwan(self, theta: ArrayLike, *, keepdims: bool = False) -> IwanParams:

@@ -164,8 +164,9 @@ def fit_candidate(c: Candidate, runs: Sequence[RunEnvelope], theta0: NDArray, *,
     """Bounded least squares of E^2 over the candidate's unit cube, from theta0 and effect start values.
 
     theta0 : (6,) or (n,) physical start, in the candidate's column order (the joint's parameters
-    alone, or with effect values; the effect values it does not give default to their `start`). starts : effect starts tried (the `start` value and evenly
-    spread points of the unit interval, for the effect parameters theta0 does not give). free_joint : False holds the joint parameters.
+    alone, or with effect values; the effect values it does not give default to their `start`).
+    starts : effect starts tried (the `start` value and evenly spread points of the unit interval,
+    for the effect parameters theta0 does not give). free_joint : False holds the joint parameters.
     refresh : times the runs' transient factor is recomputed (at theta0 first, then at each
     optimum, refitting from it); 0 keeps the runs' own factor.
     """
