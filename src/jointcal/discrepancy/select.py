@@ -32,15 +32,17 @@ from __future__ import annotations
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
 from .data import RunEnvelope
 from .fit import Candidate, Fit, envelope_E, fit_candidate, with_transient
-from .library import EFFECTS, JOIN, effects_of
+from ..effects import EFFECTS, JOIN, effects_of
 
 __all__ = ["NONE_E", "CLOSE_FRACTION", "MARGIN", "PENALTY_PER_PARAM", "WITHIN_SCATTER", "FLOOR_HIGH", "Scored",
-           "score_candidates", "needs_pairs", "pair_bases", "pair_names", "decide", "confirm", "RULE"]
+           "score_candidates", "needs_pairs", "pair_bases", "pair_names", "decide", "confirm", "RULE", "CLAUSES",
+           "Decision"]
 
 NONE_E = 1.5
 CLOSE_FRACTION = 0.6
@@ -49,19 +51,42 @@ PENALTY_PER_PARAM = 0.02
 WITHIN_SCATTER = 0.5
 FLOOR_HIGH = 1.0  # a fast-model floor above this (the repeat scatter) caps every confidence at medium
 
-RULE = (f"Scores S are held-out fast-model E (1 = the repeat scatter), S_b the baseline's, F the fast model's "
-        f"floor. 'none' if sqrt(S_b^2 - F^2) <= {NONE_E} (unless the best single effect changes with the run "
-        f"sequence, whose drift inflates the repeat scatter, and scores <= {WITHIN_SCATTER} x S_b and <= {MARGIN} x "
-        "the runner-up: named, medium; forward selection then goes on from it, and a pair with it that scores "
-        f"<= {MARGIN} x it and x the next pair is named instead, medium). Otherwise a single effect is "
-        f"named if it closes >= {CLOSE_FRACTION:.0%} of the baseline's excess over 1 and scores <= {MARGIN} x "
-        f"the runner-up (high when its score <= 2). If the best single scores above {NONE_E}, effects are added "
-        f"to it one at a time (forward selection); a pair is named instead when it closes >= "
-        f"{CLOSE_FRACTION:.0%} of the excess, scores <= {MARGIN} x the best single and <= {MARGIN} x the next "
-        "pair (high when its score <= 2). Otherwise unexplained. A fingerprint no library effect leaves (a "
-        f"dominant even harmonic) keeps a name only at score <= 2, with confidence medium; a floor F > "
-        f"{FLOOR_HIGH} caps confidence at medium. A 'none' the time simulation contradicts (E > {NONE_E} before "
-        "and after the refit) becomes unexplained.")
+# The rule in words, clause by clause: `decide` and `confirm` name the clauses they applied
+# (`Decision.applied`), so the text quoted in diagnosis.json is the one the code ran.
+CLAUSES: dict[str, str] = {
+    "scores": ("Scores S are held-out fast-model E (1 = the repeat scatter), S_b the baseline's, F the fast model's "
+               "floor."),
+    "none": f"'none' if sqrt(S_b^2 - F^2) <= {NONE_E}",
+    "drift": (f"(unless the best single effect changes with the run sequence, whose drift inflates the repeat "
+              f"scatter, and scores <= {WITHIN_SCATTER} x S_b and <= {MARGIN} x the runner-up: named, medium; "
+              f"forward selection then goes on from it, and a pair with it that scores <= {MARGIN} x it and x the "
+              "next pair is named instead, medium)."),
+    "single": (f"Otherwise a single effect is named if it closes >= {CLOSE_FRACTION:.0%} of the baseline's excess "
+               f"over 1 and scores <= {MARGIN} x the runner-up (high when its score <= 2)."),
+    "pair": (f"If the best single scores above {NONE_E}, effects are added to it one at a time (forward "
+             f"selection); a pair is named instead when it closes >= {CLOSE_FRACTION:.0%} of the excess, scores <= "
+             f"{MARGIN} x the best single and <= {MARGIN} x the next pair (high when its score <= 2)."),
+    "unexplained": "Otherwise unexplained.",
+    "outside": ("A fingerprint no library effect leaves (a dominant even harmonic) keeps a name only at score <= 2, "
+                "with confidence medium;"),
+    "floor": f"a floor F > {FLOOR_HIGH} caps confidence at medium.",
+    "none_contradicted": (f"A 'none' the time simulation contradicts (E > {NONE_E} before and after the refit) "
+                          "becomes unexplained."),
+    "name_not_confirmed": (f"A name whose time-domain E does not fall, from above {NONE_E}, keeps confidence "
+                           "low."),
+}
+RULE = " ".join(CLAUSES.values())
+
+
+class Decision(NamedTuple):
+    """What `decide` found: the effect(s) or 'none'/'unexplained', its confidence, the candidates
+    ranked by score, the whole rule (`RULE`) and the clauses of it that decided (their text)."""
+
+    effect: str
+    confidence: str
+    ranked: list
+    rule: str
+    applied: tuple[str, ...]
 
 
 @dataclass
@@ -204,9 +229,9 @@ def _above_floor(score: float, floor: float) -> float:
     return float(np.sqrt(max(score**2 - floor**2, 0.0)))
 
 
-def decide(scored: Sequence[Scored], outside: str | None = None, *, floor: float = 0.0
-           ) -> tuple[str, str, list[Scored]]:
-    """(effect(s) or 'none'/'unexplained', confidence, candidates ranked by score) by `RULE`.
+def decide(scored: Sequence[Scored], outside: str | None = None, *, floor: float = 0.0) -> Decision:
+    """The decision by `RULE`: effect(s) or 'none'/'unexplained', confidence, candidates ranked by score,
+    and the rule's text with the clauses that decided.
 
     scored : the baseline, single effects and any pairs ('a+b'). outside : a fingerprint no
     library effect leaves (`fingerprints.outside_library`), or None. floor : the fast model's
@@ -217,10 +242,11 @@ def decide(scored: Sequence[Scored], outside: str | None = None, *, floor: float
     ranked = sorted(singles + pairs, key=lambda s: s.score)
     s1 = singles[0].score if singles else np.inf
     s2 = singles[1].score if len(singles) > 1 else np.inf
-    name, conf = _rule(base.score, s1, s2, singles, pairs, outside, floor)
+    name, conf, keys = _rule(base.score, s1, s2, singles, pairs, outside, floor)
     if conf == "high" and floor > FLOOR_HIGH:
         conf = "medium"
-    return name, conf, ranked
+        keys += ("floor",)
+    return Decision(name, conf, ranked, RULE, tuple(CLAUSES[k] for k in ("scores", *keys)))
 
 
 def _drifts(name: str) -> bool:
@@ -246,26 +272,29 @@ def _pair_wins(pairs: Sequence[Scored], s1: float) -> bool:
     return p1 <= MARGIN * s1 and p1 <= MARGIN * p2
 
 
-def _rule(sb, s1, s2, singles, pairs, outside, floor) -> tuple[str, str]:
+def _rule(sb, s1, s2, singles, pairs, outside, floor) -> tuple[str, str, tuple[str, ...]]:
+    """(name, confidence, the keys of the `CLAUSES` applied)."""
+    out = ("outside",) if outside else ()
     if _above_floor(sb, floor) <= NONE_E:
         if _within_scatter_drift(sb, singles, outside):
             if pairs and _drifts(pairs[0].name) and _pair_wins(pairs, s1):
-                return pairs[0].name, "medium"
-            return singles[0].name, "medium"
-        return "none", "high" if (not singles or s1 > 0.8 * sb) else "medium"
+                return pairs[0].name, "medium", ("none", "drift")
+            return singles[0].name, "medium", ("none", "drift")
+        return "none", "high" if (not singles or s1 > 0.8 * sb) else "medium", ("none",)
     if pairs:
         p1 = pairs[0].score
         if _closes(sb, p1) and _pair_wins(pairs, s1) and not (outside and p1 > 2.0):
-            return pairs[0].name, "high" if (p1 <= 2.0 and not outside) else "medium"
+            return pairs[0].name, "high" if (p1 <= 2.0 and not outside) else "medium", ("pair", *out)
     if not singles:
-        return "unexplained", "low"
+        return "unexplained", "low", ("unexplained",)
     if _closes(sb, s1) and s1 <= MARGIN * s2 and not (outside and s1 > 2.0):
-        return singles[0].name, "high" if (s1 <= 2.0 and not outside) else "medium"
-    return "unexplained", "low"
+        return singles[0].name, "high" if (s1 <= 2.0 and not outside) else "medium", ("single", *out)
+    return "unexplained", "low", ("single", "pair", "unexplained", *out) if pairs else ("single", "unexplained", *out)
 
 
 def confirm(effect: str, confidence: str, e_before: float, e_after: float) -> tuple[str, str, str | None]:
-    """The time simulation's word on a decision: (effect, confidence, note) by the end of `RULE`.
+    """The time simulation's word on a decision: (effect, confidence, note) by the end of `RULE`
+    (the note is the key of the clause applied, `CLAUSES[note]`).
 
     e_before, e_after : the time-domain E of the calibrated model and of the decided model
     recalibrated. 'none' with both above `NONE_E` is contradicted (-> 'unexplained', note

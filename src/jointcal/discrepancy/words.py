@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from .library import EFFECTS
+from ..effects import EFFECTS
 from .select import NONE_E
 
 __all__ = ["diagnosis_markdown"]

@@ -15,7 +15,7 @@ so the force the gauge reads is m x'' + c x' + k x + F_joint(x): the structure's
 dynamic stiffness times x, which is smallest at the structure's resonance (the force
 drops out there), and the ratio response / voltage is the rig's FRF, the shaker's
 mass, suspension and electrical damping Bl Bl_e / R included. The joint's nonlinear
-remainder r_nl = F_iwan - KT x (and the effects' k3, c2 terms) enters as in
+remainder r_nl = F_iwan - KT x (and the forces of the model's elements) enters as in
 `jointcal.models.simulate`, whose exact-Iwan kernel integrates this 3-state system.
 
 A second, linear mode of the structure at the driving point (`StructureMode`: natural
@@ -43,10 +43,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..models import G, MinistackModel, harmonic_balance
-from ..models import _integrator
-from ..models._masing import kernel_constants
 from ..models.iwan import derived
-from ..models.simulate import _substep_maps, band_limited, fractional_delay, hermite_propagator
+from ..models.simulate import band_limited, fractional_delay, integrate
+from ..models.structure import StateSpace
 
 __all__ = ["Shaker", "StructureMode", "BL_E_PER_BL", "peak_amplitude", "rig_matrices", "simulate_rig", "structure_equivalent", "rig_pole",
            "steady_amplitude", "structure_resonance_amplitude", "rig_truth"]
@@ -183,7 +182,7 @@ def simulate_rig(model: MinistackModel, shaker: Shaker, volts: NDArray, fs: floa
     Parameters
     ----------
     model : MinistackModel
-        The structure (joint, k, zeta_v, mass; effects k3, c2, sensor_gain,
+        The structure (joint, k, zeta_v, mass; its elements, sensor_gain and
         sensor_delay_s apply as in `jointcal.models.simulate`).
     shaker : Shaker
     volts : ndarray, shape (N,)
@@ -212,28 +211,10 @@ def simulate_rig(model: MinistackModel, shaker: Shaker, volts: NDArray, fs: floa
     u, U = band_limited(u, fs, w0 / (2 * np.pi))  # as `simulate` reads its input
     fs = fs * U
     n_sub = max(1, int(np.ceil(w0 / (omega_h * fs))))
-    H = 1.0 / fs
-    h = H / n_sub
-    Phi, Gu = hermite_propagator(A, bu, h)
-    _, Gf = hermite_propagator(A, bf, h)
-    Gsub, Wub = _substep_maps(Gu, n_sub)
     lz, lv = np.eye(A.shape[0])[0], np.eye(A.shape[0])[1]
-    az, bzu, bzf = lv @ A, float(lv @ bu), float(lv @ bf)
-    if model.iwan is None:
-        joint, KT, R, chi, phimax, Fs = 0, 0.0, 0.0, 0.5, 1.0, 0.0
-    else:
-        p = model.iwan
-        phimax, R, _ = (float(a) for a in derived(p.Fs, p.KT, p.chi, p.beta))
-        R, chi = kernel_constants(R, p.chi)
-        joint, KT, Fs = 1, p.KT, p.Fs
-    res = {}
-    for name, (cy, dyu, dyf) in outs.items():  # the same trajectory once per output
-        y, x = np.empty_like(u), np.empty_like(u)
-        _integrator.run(u, _integrator.rate(u, fs), H, Gsub, Wub, np.ascontiguousarray(Phi),
-                        np.ascontiguousarray(Gf), lz, lv, az, bzu, bzf, np.ascontiguousarray(cy), float(dyu),
-                        float(dyf), joint, KT, R, chi, phimax, Fs, np.zeros(0), np.zeros(0), float(model.k3),
-                        float(model.c2), float(model.contact_k), float(model.contact_gap_in), y, x)
-        res[name] = y[::U][:n_out].copy()
+    ss = StateSpace(A, bu, bf, *outs["accel"], lz, lv)
+    Y, x = integrate(ss, u, fs, n_sub, iwan=model.iwan, elements=model.elements, outputs=list(outs.values()))
+    res = {name: y[::U][:n_out].copy() for name, y in zip(outs, Y)}
     x = x[::U][:n_out].copy()
     fs = fs / U
     acc = res["accel"]
