@@ -67,6 +67,15 @@ def test_config_schema_lists_the_library():
     assert config["discrepancy"]["candidates"] == list(library())
 
 
+def test_docs_tables_list_the_registry():
+    """The README's effect table and the package docstring's name every registered effect, in order."""
+    readme = (ROOT / "README.md").read_text()
+    table = readme[readme.index("## Effects (`jointcal.effects`)"):].split("\n\n")[2]
+    assert [r.split("`")[1] for r in table.splitlines()[2:]] == list(EFFECTS)
+    rows = effects.__doc__.split("=====\n")[2].splitlines()
+    assert [r.split()[0] for r in rows if r and not r.startswith((" ", "="))] == list(EFFECTS)
+
+
 def test_every_effect_module_is_registered_once():
     modules = [m.name for m in pkgutil.iter_modules(effects.__path__) if m.name not in ("effect", "registry")]
     assert sorted(modules) == sorted(EFFECTS)
