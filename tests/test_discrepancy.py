@@ -18,7 +18,8 @@ from jointcal.calibrate.space import PARAMS
 from jointcal.discrepancy import EFFECTS, DiscrepancySettings, decide, diagnose, diagnosis_markdown, score_candidates
 from jointcal.discrepancy.data import RunEnvelope
 from jointcal.discrepancy.fit import candidate, envelope_E, model_at, predict
-from jointcal.discrepancy.select import NONE_E, Scored, confirm, needs_pairs, pair_names
+from jointcal.discrepancy.rule import NONE_E, confirm
+from jointcal.discrepancy.select import Scored, needs_pairs, pair_names
 from jointcal.discrepancy.stage import valley_starts
 from jointcal.models import G
 

@@ -5,12 +5,13 @@ The effects it tries are the library of `jointcal.effects` (one module each). Mo
 the order data flows: `data` (measured envelope
 frames and the run's drive), `fit` (the swept fast-model envelope objective and its fits),
 `floor` (the fast model's own error against the time simulation), `fingerprints`
-(residual maps, fingerprint features), `select` (held-out scoring, forward selection and
-the decision rule), `recalibrate` (GA, polish, posterior of the chosen model), `stage`
+(residual maps, fingerprint features), `select` (held-out scoring, forward selection), `rule`
+(the decision rule), `recalibrate` (GA, polish, posterior of the chosen model), `stage`
 (one assembly, end to end), `words` (the diagnosis in plain language).
 """
 from ..effects import EFFECTS, Effect, EffectParam, apply_effect
-from .select import decide, score_candidates
+from .rule import decide
+from .select import score_candidates
 from .stage import DiscrepancySettings, diagnose
 from .words import diagnosis_markdown
 

@@ -7,14 +7,14 @@
 2. Candidates: the baseline and every library effect (`jointcal.effects.library()`), each refit on
    the envelopes through the fast model (`fit`), scored on held-out levels (`select`);
    when no single effect brings the score to the scatter, pairs by forward selection.
-3. Decide by `select.decide`'s rule (`select.RULE`), which returns the clauses that decided.
+3. Decide by `rule.decide` (`rule.RULE`), which returns the clauses that decided.
 4. Act: the named model recalibrated with the joint parameters (`recalibrate`:
    DEAP GA over the grown space seeded with the least-squares fits from the calibration's
    optimum and its other valleys, polish, emcee posterior for the 90% intervals),
    revalidated by the TIME simulation driven by each run's measured base record
    (`jointcal.validate.validate_runs`, the validation stage's E: same definition, same
    runs) -> metric_before, metric_after. A 'none' that the time simulation contradicts
-   (E above `select.NONE_E` before and after) becomes 'unexplained'; a name the time
+   (E above `rule.NONE_E` before and after) becomes 'unexplained'; a name the time
    simulation does not confirm (E not lower after) keeps confidence low.
 """
 from __future__ import annotations
@@ -35,7 +35,8 @@ from .fingerprints import fingerprints, outside_library, residual_map, verdicts
 from .fit import candidate, fit_candidate, model_at, with_transient
 from .floor import fast_floor
 from .recalibrate import recalibrate
-from .select import CLAUSES, confirm, decide, needs_pairs, pair_bases, pair_names, score_candidates
+from .rule import CLAUSES, confirm, decide
+from .select import needs_pairs, pair_bases, pair_names, score_candidates
 from .words import diagnosis_markdown
 
 __all__ = ["DiscrepancySettings", "diagnose", "diagnosis_markdown", "valley_starts"]

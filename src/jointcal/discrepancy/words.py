@@ -20,7 +20,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from ..effects import EFFECTS
-from .select import NONE_E
+from .rule import NONE_E
 
 __all__ = ["diagnosis_markdown"]
 

@@ -64,8 +64,7 @@ def _J(chi, smax, nodes, weights):
 @njit(cache=True, inline="always")
 def _cubic(q, a, re, dre):
     """Cubic spring a z^3: 3/4 a q^2 in phase (added to re, and its q-slope to dre)."""
-    t = 0.75 * a * q * q
-    return re + t, dre + 2.0 * t
+    return re + 0.75 * a * q * q, dre + 2.0 * (0.75 * a * q * q)
 
 
 @njit(cache=True, inline="always")
@@ -79,15 +78,11 @@ def _quadratic_damper(q, w, a, im, dim, C, C1):
 def _stiffness(q, s, w, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes, weights):
     """Complex dynamic stiffness of the joint DOF at amplitude q (in) and omega w (rad/s).
 
-    Returns (Re, Im, dRe/ds, dIm/ds, C, C1) with s = log q (passed too: q^e = exp(e s)), C = dIm/domega
-    at fixed q (lbf s/in) and C1 = dC/domega. kp: linear springs in parallel (k); c: dashpot; Iwan (KT, R,
-    chi, phimax, S; J1 = J(chi, 1)); codes, coefs (n_e,), (n_e, 2): the element table
-    (`jointcal.models.elements`; the contact spring has no describing function and is refused before).
+    Returns (Re, Im, dRe/ds, dIm/ds, C, C1) with s = log q (passed too: q^e = exp(e s)), C = dIm/domega at
+    fixed q (lbf s/in), C1 = dC/domega. kp: linear springs in parallel (k); c: dashpot; Iwan (KT, R, chi,
+    phimax, S; J1 = J(chi, 1)); codes (n_e,), coefs (n_e, 2): the element table (`models.elements`).
     """
-    re = kp
-    im = w * c
-    dre = 0.0
-    dim = 0.0
+    re, im, dre, dim = kp, w * c, 0.0, 0.0
     if KT > 0.0:
         e = chi + 1.0
         if q <= phimax:
@@ -114,14 +109,12 @@ def _stiffness(q, s, w, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes, w
             dD = 4.0 * R * u ** (chi + 2.0) / (chi + 2.0) + 4.0 * S * phimax  # dD/dq
             im += D / (PI * q * q)
             dim += (q * dD - 2.0 * D) / (PI * q * q)
-    C = c  # dIm/domega at fixed q, and its own omega-slope C1
-    C1 = 0.0
-    for i in range(codes.shape[0]):
-        a = coefs[i, 0]
+    C, C1 = c, 0.0  # dIm/domega at fixed q, and its own omega-slope
+    for i in range(codes.shape[0]):  # the element table: one inline function per kind
         if codes[i] == 1:  # cubic spring
-            re, dre = _cubic(q, a, re, dre)
+            re, dre = _cubic(q, coefs[i, 0], re, dre)
         elif codes[i] == 3:  # quadratic damper
-            im, dim, C, C1 = _quadratic_damper(q, w, a, im, dim, C, C1)
+            im, dim, C, C1 = _quadratic_damper(q, w, coefs[i, 0], im, dim, C, C1)
     return re, im, dre, dim, C, C1
 
 

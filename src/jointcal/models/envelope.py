@@ -165,6 +165,23 @@ def _structure_terms(model: MinistackModel, w: NDArray, shape) -> tuple[NDArray,
     return w**2 * m * (1.0 + w**2 * m / a11), kc / a11
 
 
+def _checked(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike, direction: str) -> tuple[NDArray, NDArray]:
+    """Frequencies f (N,), Hz, and base amplitudes A (N,), in/s^2; one sentence for each bad input."""
+    if direction not in ("up", "down"):
+        raise ValueError(f"direction must be 'up' or 'down', got {direction!r}.")
+    f = np.atleast_1d(np.asarray(f_hz, dtype=float))
+    if f.ndim != 1 or not np.all(np.isfinite(f) & (f > 0)):
+        raise ValueError("steady_state: f_hz must be a 1-D array of positive, finite frequencies in Hz.")
+    A = np.broadcast_to(np.asarray(base_g, dtype=float), f.shape) * G
+    if not np.all(np.isfinite(A) & (A > 0)):
+        raise ValueError("steady_state: base_g must be positive and finite (g) at every frequency.")
+    other = [NAMES[e.code] for e in model.elements if e.code not in FIRST_HARMONIC]
+    if other:
+        raise ValueError(f"steady_state has no first-harmonic model of a {', '.join(other)} (a unilateral contact: "
+                         "its response has a mean offset and even harmonics); use jointcal.models.simulate.")
+    return f, A
+
+
 def steady_state(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike = 1.0, *,
                  direction: Literal["up", "down"] = "up") -> SteadyState:
     """Steady-state first-harmonic response of a base-excited model along a sweep.
@@ -196,18 +213,7 @@ def steady_state(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike = 1.0
     continued from the neighbouring frequency), so it is an exact describing-function
     solution, not a grid value; dashpot convention as `harmonic_balance(viscous="dashpot")`.
     """
-    if direction not in ("up", "down"):
-        raise ValueError(f"direction must be 'up' or 'down', got {direction!r}.")
-    f = np.atleast_1d(np.asarray(f_hz, dtype=float))
-    if f.ndim != 1 or not np.all(np.isfinite(f) & (f > 0)):
-        raise ValueError("steady_state: f_hz must be a 1-D array of positive, finite frequencies in Hz.")
-    A = np.broadcast_to(np.asarray(base_g, dtype=float), f.shape) * G
-    if not np.all(np.isfinite(A) & (A > 0)):
-        raise ValueError("steady_state: base_g must be positive and finite (g) at every frequency.")
-    other = [NAMES[e.code] for e in model.elements if e.code not in FIRST_HARMONIC]
-    if other:
-        raise ValueError(f"steady_state has no first-harmonic model of a {', '.join(other)} (a unilateral contact: "
-                         "its response has a mean offset and even harmonics); use jointcal.models.simulate.")
+    f, A = _checked(model, f_hz, base_g, direction)
     shape, out_shape = _batch_shape(model, f.shape)
     P = shape[0]
     w = 2 * np.pi * f

@@ -22,7 +22,8 @@ from ..io import write_csv_atomic, write_json_atomic, write_run
 from ..models import G, resonance_amplitude, simulate
 from . import daq
 from .hidden import effect_defaults, run_model
-from .shaker import Shaker, StructureMode, rig_truth, simulate_rig
+from .rig_truth import rig_truth
+from .shaker import Shaker, StructureMode, simulate_rig
 from .spec import JOINT_KEYS, RIG_LEVEL, load_spec
 
 __all__ = ["generate", "plan_runs"]
