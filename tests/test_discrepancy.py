@@ -197,6 +197,22 @@ def test_the_fast_models_floor_is_taken_out_of_the_baseline_before_none():
     assert decide(strong)[1] == "high" and decide(strong, floor=1.2)[1] == "medium"
 
 
+def test_decide_quotes_the_clauses_of_its_rule_that_decided():
+    """The decision carries the rule's text and, of it, the clauses the code applied (what diagnosis.json
+    quotes): a named single, 'none', a floor cap, unexplained after pairs, and the time-domain notes."""
+    from jointcal.discrepancy.rule import CLAUSES, RULE
+    strong = [_scored("baseline", 20.0), _scored("sensor_gain", 1.5), _scored("channel_delay", 15.0)]
+    d = decide(strong)
+    assert d.rule == RULE and d.applied == (CLAUSES["scores"], CLAUSES["single"])
+    assert decide(strong, floor=1.2).applied[-1] == CLAUSES["floor"]
+    assert decide([_scored("baseline", 1.2), _scored("sensor_gain", 1.1)]).applied[-1] == CLAUSES["none"]
+    alike = [_scored("baseline", 9.0), _scored("sensor_gain", 6.0), _scored("channel_delay", 6.2),
+             _scored("sensor_gain+channel_delay", 5.9)]
+    assert decide(alike).applied[1:] == (CLAUSES["single"], CLAUSES["pair"], CLAUSES["unexplained"])
+    assert all(c in RULE for c in CLAUSES.values()) and RULE.endswith(CLAUSES["name_not_confirmed"])
+    assert confirm("none", "high", 2.0, 1.9)[2] in CLAUSES and confirm("a", "high", 6.0, 6.5)[2] in CLAUSES
+
+
 def test_within_the_scatter_only_a_drift_with_the_sequence_is_named():
     """A baseline within the scatter is 'none' even if a candidate halves it, unless that candidate drifts
     with the run sequence (its drift inflates the repeat scatter the baseline is judged by)."""
