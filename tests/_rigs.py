@@ -20,7 +20,8 @@ from jointcal.modal import measure_run
 from jointcal.models import G
 from jointcal.synth import generate
 from jointcal.synth.campaign import _model
-from jointcal.synth.shaker import Shaker, StructureMode, rig_pole, steady_amplitude, structure_equivalent
+from jointcal.synth.rig_truth import rig_pole, steady_amplitude, structure_equivalent
+from jointcal.synth.shaker import Shaker, StructureMode
 
 JOINTED_BEAM = {"k": 818.0, "Fs": 4.0, "KT": 204.0, "chi": -0.5, "beta": 0.1, "zeta_v": 0.008, "weight_lbf": 1.0}
 SMALL_SHAKER = {"armature_weight_lbf": 0.05, "suspension_hz": 15.0, "bl_lbf_per_A": 0.5, "coil_ohm": 2.0,

@@ -18,7 +18,8 @@ from jointcal.calibrate.space import PARAMS
 from jointcal.discrepancy import EFFECTS, DiscrepancySettings, decide, diagnose, diagnosis_markdown, score_candidates
 from jointcal.discrepancy.data import RunEnvelope
 from jointcal.discrepancy.fit import candidate, envelope_E, model_at, predict
-from jointcal.discrepancy.select import NONE_E, Scored, confirm, needs_pairs, pair_names
+from jointcal.discrepancy.rule import NONE_E, confirm
+from jointcal.discrepancy.select import Scored, needs_pairs, pair_names
 from jointcal.discrepancy.stage import valley_starts
 from jointcal.models import G
 
@@ -62,7 +63,7 @@ def test_a_new_library_effect_grows_the_space_and_is_fitted_without_other_change
     T_read = T / b) is registered in the library only; the fit's space becomes the six joint columns
     plus b with its bounds and scaling, and the hidden b = 0.9 is recovered and named."""
     from dataclasses import replace as dc_replace
-    from jointcal.discrepancy.library import Effect, EffectParam
+    from jointcal.effects import Effect, EffectParam
     new = Effect("base_gain", (EffectParam("b", "-", 0.5, 2.0, True, 1.0, "base channel reading / true"),),
                  lambda m, v, row: dc_replace(m, sensor_gain=m.sensor_gain / v["b"]), lambda v: "check the base")
     monkeypatch.setitem(EFFECTS, "base_gain", new)
@@ -71,7 +72,7 @@ def test_a_new_library_effect_grows_the_space_and_is_fitted_without_other_change
     np.testing.assert_allclose(c.to_unit(np.r_[TRUTH, 1.0])[-1], 0.5)  # log scale: 1 is the middle of [0.5, 2]
     runs = _runs("base_gain", [0.9])
     cands = [candidate(n, SPACE, M) for n in ("baseline", "base_gain", "channel_delay")]
-    name, conf, ranked = decide(score_candidates(cands, runs, TRUTH * np.array([1.1, 0.95, 1, 1, 1.05, 1.2]),
+    name, conf, ranked, *_ = decide(score_candidates(cands, runs, TRUTH * np.array([1.1, 0.95, 1, 1, 1.05, 1.2]),
                                                  max_nfev=25))
     assert name == "base_gain" and abs(ranked[0].fit.theta[6] / 0.9 - 1) < 0.03
 
@@ -88,7 +89,7 @@ def test_a_hidden_effect_is_named_and_recovered(effect, values):
     cands = [candidate(n, SPACE, M) for n in ("baseline", "sensor_gain", "channel_delay", "fixture_flexibility")]
     start = TRUTH * np.array([1.1, 0.95, 1.0, 1.0, 1.05, 1.2])  # a calibration slightly off
     scored = score_candidates(cands, runs, start, max_nfev=25)
-    name, conf, ranked = decide(scored)
+    name, conf, ranked, *_ = decide(scored)
     print("\n" + ", ".join(f"{s.name} {s.score:.2f}" for s in scored) + f" -> {name} ({conf})")
     assert name == effect and conf == "high"
     fitted = ranked[0].fit.theta[6]
@@ -98,7 +99,7 @@ def test_a_hidden_effect_is_named_and_recovered(effect, values):
 def test_no_effect_gives_none():
     runs = _runs(seed=3)
     cands = [candidate(n, SPACE, M) for n in ("baseline", "sensor_gain", "channel_delay")]
-    name, _, _ = decide(score_candidates(cands, runs, TRUTH, max_nfev=20))
+    name, *_ = decide(score_candidates(cands, runs, TRUTH, max_nfev=20))
     assert name == "none"
 
 
@@ -106,7 +107,7 @@ def test_the_sweep_lag_is_not_mistaken_for_a_delay():
     """Envelopes seen through a fast sweep (first-order lag, opposite in up and down sweeps) with no effect."""
     runs = _runs(seed=4, rate=300.0)
     cands = [candidate(n, SPACE, M) for n in ("baseline", "channel_delay")]
-    name, _, _ = decide(score_candidates(cands, runs, TRUTH, max_nfev=20))
+    name, *_ = decide(score_candidates(cands, runs, TRUTH, max_nfev=20))
     assert name == "none"
 
 
@@ -178,7 +179,7 @@ def test_gain_and_delay_hidden_together_are_named_both():
     base = next(s for s in singles if s.name == "baseline")
     pairs = score_candidates([candidate(n, SPACE, M) for n in names], runs, start, max_nfev=25, baseline=base,
                              starts={n: [fits[n.split("+")[0]]] for n in names})
-    name, conf, ranked = decide(singles + pairs)
+    name, conf, ranked, *_ = decide(singles + pairs)
     print("\n" + ", ".join(f"{s.name} {s.score:.2f}" for s in singles + pairs) + f" -> {name} ({conf})")
     assert set(name.split("+")) == {"sensor_gain", "channel_delay"} and conf == "high"
     c = candidate(name, SPACE, M)
@@ -194,6 +195,22 @@ def test_the_fast_models_floor_is_taken_out_of_the_baseline_before_none():
     assert decide(sc, floor=1.2)[0] == "none"
     strong = [_scored("baseline", 20.0), _scored("sensor_gain", 1.5), _scored("channel_delay", 15.0)]
     assert decide(strong)[1] == "high" and decide(strong, floor=1.2)[1] == "medium"
+
+
+def test_decide_quotes_the_clauses_of_its_rule_that_decided():
+    """The decision carries the rule's text and, of it, the clauses the code applied (what diagnosis.json
+    quotes): a named single, 'none', a floor cap, unexplained after pairs, and the time-domain notes."""
+    from jointcal.discrepancy.rule import CLAUSES, RULE
+    strong = [_scored("baseline", 20.0), _scored("sensor_gain", 1.5), _scored("channel_delay", 15.0)]
+    d = decide(strong)
+    assert d.rule == RULE and d.applied == (CLAUSES["scores"], CLAUSES["single"])
+    assert decide(strong, floor=1.2).applied[-1] == CLAUSES["floor"]
+    assert decide([_scored("baseline", 1.2), _scored("sensor_gain", 1.1)]).applied[-1] == CLAUSES["none"]
+    alike = [_scored("baseline", 9.0), _scored("sensor_gain", 6.0), _scored("channel_delay", 6.2),
+             _scored("sensor_gain+channel_delay", 5.9)]
+    assert decide(alike).applied[1:] == (CLAUSES["single"], CLAUSES["pair"], CLAUSES["unexplained"])
+    assert all(c in RULE for c in CLAUSES.values()) and RULE.endswith(CLAUSES["name_not_confirmed"])
+    assert confirm("none", "high", 2.0, 1.9)[2] in CLAUSES and confirm("a", "high", 6.0, 6.5)[2] in CLAUSES
 
 
 def test_within_the_scatter_only_a_drift_with_the_sequence_is_named():

@@ -6,7 +6,7 @@ from scipy.signal import fftconvolve
 from _lockin import linear_sweep
 from jointcal.models.envelope import _structure_terms
 from jointcal.models import (
-    G, Fixture, IwanParams, MinistackModel, dissipation, harmonic_balance, simulate, steady_state,
+    G, Fixture, IwanParams, MinistackModel, cubic_spring, dissipation, harmonic_balance, simulate, steady_state,
 )
 
 M = 2.65 / G
@@ -88,7 +88,7 @@ CASES = [
     # (weak hysteresis harmonics) and a stiffer can at every level.
     ("fixture", dict(fixture=Fixture(4 * M, 5500.0, 0.01)), (1.0,)),
     ("fixture_8k", dict(fixture=Fixture(4 * M, 8000.0, 0.01)), (1.0, 5.0, 10.0)),
-    ("cubic", dict(k3=5e11), (1.0, 10.0)),
+    ("cubic", dict(elements=(cubic_spring(5e11),)), (1.0, 10.0)),
 ]
 
 
@@ -140,10 +140,10 @@ def test_vectorised_over_parameter_sets_equals_one_at_a_time():
     f = np.linspace(1800, 2500, 300)
     Fs = np.array([[200.0], [313.0], [600.0]])
     batch = steady_state(MinistackModel(m=M, k=K, zeta_v=ZV, iwan=IwanParams(Fs, IWAN.KT, IWAN.chi, IWAN.beta),
-                                        k3=np.array([[0.0], [5e11], [1e11]])), f, 5.0)
+                                        elements=(cubic_spring(np.array([[0.0], [5e11], [1e11]])),)), f, 5.0)
     for i, (fs_i, k3_i) in enumerate(zip(Fs[:, 0], (0.0, 5e11, 1e11))):
         one = steady_state(MinistackModel(m=M, k=K, zeta_v=ZV, iwan=IwanParams(fs_i, IWAN.KT, IWAN.chi, IWAN.beta),
-                                          k3=k3_i), f, 5.0)
+                                          elements=(cubic_spring(k3_i),)), f, 5.0)
         np.testing.assert_allclose(batch.transmissibility[i], one.transmissibility, rtol=1e-12)
 
 
@@ -155,7 +155,7 @@ def test_fold_branches_follow_the_sweep_direction():
     (The Iwan joints of Table 3.2's family, alone, showed a single root at every frequency when the
     fixed point was scanned on a fine log-q grid, 1 to 10 g: their damping grows with the softening.)
     """
-    model = MinistackModel(m=M, k=1.63e6, zeta_v=0.02, k3=2e13)
+    model = MinistackModel(m=M, k=1.63e6, zeta_v=0.02, elements=(cubic_spring(2e13),))
     f = np.linspace(2400, 3000, 2401)
     up = steady_state(model, f, 5.0, direction="up")
     down = steady_state(model, f, 5.0, direction="down")

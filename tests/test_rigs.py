@@ -16,7 +16,8 @@ from jointcal.modal import measure_run
 from jointcal.models import G, IwanParams, MinistackModel
 from jointcal.synth import generate, load_spec
 from jointcal.synth.daq import controlled_sweep
-from jointcal.synth.shaker import Shaker, StructureMode, _rig_poly, _x_over_v, rig_matrices, rig_pole, simulate_rig
+from jointcal.synth.rig_truth import _rig_poly, _x_over_v, rig_pole
+from jointcal.synth.shaker import Shaker, StructureMode, rig_matrices, simulate_rig
 
 BEAM = {"k": 1022.0, "zeta_v": 0.015, "weight_lbf": 1.0}  # 100 Hz, zeta 1.5%, linear
 SHAKER = {"armature_weight_lbf": 0.05, "suspension_hz": 15.0, "bl_lbf_per_A": 0.5, "coil_ohm": 2.0, "coil_mH": 0.3}
@@ -140,7 +141,7 @@ def test_ministack_force_rig_slow_chirp(tmp_path):
     equivalent-linear resonance and damping at the amplitude the run reached (q_in, the response's peak at
     the shaker-loaded resonance) within 0.2% / 5%; the FRF's quadrature, beside it, the structure's own phase
     resonance at its (smaller) amplitude there."""
-    from jointcal.synth.shaker import structure_equivalent
+    from jointcal.synth.rig_truth import structure_equivalent
 
     rate = 0.5 * (2320.0 * 0.019) ** 2
     runs, props, truth = _campaign(tmp_path, "force", MINISTACK, (1500.0, 2700.0), 12800.0, rate, 3.2281, tail=0.1)
@@ -162,7 +163,7 @@ def test_ministack_voltage_rig_chirp(tmp_path, eta):
     equal-amplitude pair backbone reads the rig's pole at the steady-state amplitude within 0.2% / 5%; at
     eta 20 the chirp outruns the joint (the amplitude reaches ~3/4 of the steady state) and every FRF
     read-out misses, while the swept-mode fit gives the rig's pole at the amplitude reached within 0.2% / 5%."""
-    from jointcal.synth.shaker import rig_pole
+    from jointcal.synth.rig_truth import rig_pole
 
     rate = eta * (2157.0 * 0.0193) ** 2
     band = (1900.0, 2450.0) if eta < 1 else (1500.0, 2700.0)  # the fast chirp: the benchmark's band

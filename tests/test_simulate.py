@@ -5,7 +5,7 @@ from scipy.integrate import quad_vec
 
 from _lockin import demodulate, linear_sweep, quadrature
 from jointcal.models import G, Fixture, IwanParams, MinistackModel, harmonic_balance, qsma
-from jointcal.models import resonance_amplitude, simulate
+from jointcal.models import contact_spring, resonance_amplitude, simulate
 from jointcal.models.simulate import fractional_delay, hermite_propagator
 from jointcal.models.sliders import slider_set
 from jointcal.models.structure import state_space
@@ -167,7 +167,7 @@ def test_unilateral_contact_free_vibration_matches_piecewise_closed_form(gap):
     Period, positive peak (energy: 1/2 k A^2 = 1/2 k z+^2 + 1/2 kc (z+ - gap)^2) and no drift of the
     peaks over ~700 cycles are checked against that closed form."""
     k, kc, fs = 6e5, 6e5, 25600.0
-    model = MinistackModel(m=M, k=k, zeta_v=0.0, contact_k=kc, contact_gap_in=gap)
+    model = MinistackModel(m=M, k=k, zeta_v=0.0, elements=(contact_spring(kc, gap),))
     t = np.arange(int(fs * 0.5)) / fs
     a = 50.0 * np.where(t < 2e-4, 1.0, 0.0) * np.sin(np.pi * t / 2e-4)  # a bump, then free vibration
     z = simulate(model, a, fs).z_in[100:]
@@ -189,6 +189,7 @@ def test_contact_has_no_steady_state_model():
     """The first-harmonic envelope model refuses a contact rather than silently ignoring it."""
     from jointcal.models import steady_state
     with pytest.raises(ValueError, match="unilateral contact"):
-        steady_state(MinistackModel(m=M, k=6e5, zeta_v=0.001, contact_k=1e5), [1000.0, 1100.0], 1.0, direction="up")
-    with pytest.raises(ValueError, match="contact_k"):
-        MinistackModel(m=M, k=6e5, zeta_v=0.001, contact_k=-1.0)
+        steady_state(MinistackModel(m=M, k=6e5, zeta_v=0.001, elements=(contact_spring(1e5),)), [1000.0, 1100.0], 1.0,
+                     direction="up")
+    with pytest.raises(ValueError, match="contact spring"):
+        MinistackModel(m=M, k=6e5, zeta_v=0.001, elements=(contact_spring(-1.0),))

@@ -20,7 +20,7 @@ from jointcal.io import read_manifest, read_run, write_csv_atomic
 from jointcal.modal import measure_run
 from jointcal.models import MinistackModel, simulate
 from jointcal.synth import generate
-from jointcal.synth.effects import run_model
+from jointcal.synth.hidden import run_model
 from jointcal.validate import (
     ValidateSettings, band_frames, compare_run, draw_transmissibility, model_from_best, simulate_record,
     validate_runs,

@@ -43,7 +43,8 @@ from jointcal.modal import measure_run
 from jointcal.models import G
 from jointcal.synth import generate
 from jointcal.synth.campaign import _model
-from jointcal.synth.shaker import Shaker, rig_pole, rig_truth, steady_amplitude, structure_equivalent
+from jointcal.synth.rig_truth import rig_pole, rig_truth, steady_amplitude, structure_equivalent
+from jointcal.synth.shaker import Shaker
 
 MINISTACK = {"Fs": 313.0, "KT": 1.02e6, "chi": -0.65, "beta": 0.004, "k": 6.12e5, "zeta_v": 0.0015}
 BEAM = {"k": 1022.0, "zeta_v": 0.015, "weight_lbf": 1.0}

@@ -15,7 +15,7 @@ import numpy as np
 from jointcal.models import simulate
 from jointcal.synth import generate, load_spec
 from jointcal.synth.daq import controlled_sweep
-from jointcal.synth.effects import run_model
+from jointcal.synth.hidden import run_model
 from jointcal.models import G
 
 

@@ -1,15 +1,17 @@
 """The discrepancy workflow: where simulation and measurement disagree, which named physical
 effect (or pair of effects) is missing, the model with it added, and the gap before and after.
 
-Modules in the order data flows: `library` (the named effects), `data` (measured envelope
+The effects it tries are the library of `jointcal.effects` (one module each). Modules in
+the order data flows: `data` (measured envelope
 frames and the run's drive), `fit` (the swept fast-model envelope objective and its fits),
 `floor` (the fast model's own error against the time simulation), `fingerprints`
-(residual maps, fingerprint features), `select` (held-out scoring, forward selection and
-the decision rule), `recalibrate` (GA, polish, posterior of the chosen model), `stage`
+(residual maps, fingerprint features), `select` (held-out scoring, forward selection), `rule`
+(the decision rule), `recalibrate` (GA, polish, posterior of the chosen model), `stage`
 (one assembly, end to end), `words` (the diagnosis in plain language).
 """
-from .library import EFFECTS, Effect, EffectParam, apply_effect
-from .select import decide, score_candidates
+from ..effects import EFFECTS, Effect, EffectParam, apply_effect
+from .rule import decide
+from .select import score_candidates
 from .stage import DiscrepancySettings, diagnose
 from .words import diagnosis_markdown
 

@@ -2,7 +2,8 @@
 
 Residuals are the measured transmissibility over the baseline model's (the swept fast
 model, `fit.predict`), in dB and degrees, divided by the repeat scatter of
-their bin. Fingerprints:
+their bin. Fingerprints (each effect's test of them is its module's ``fingerprint``,
+`jointcal.effects`):
 
 ==========================  ==========================================================  ==================
 feature                     how                                                         points at
@@ -30,6 +31,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
+from ..effects import EFFECTS
 from .data import RunEnvelope
 from .fit import Candidate, predict
 
@@ -113,31 +115,20 @@ def fingerprints(res: pd.DataFrame, modal: pd.DataFrame, model_fz: Mapping[str, 
 
 
 def verdicts(fp: Mapping[str, float | None], sigma_db: float, sigma_f: float) -> dict[str, dict[str, list[str]]]:
-    """Per library effect: the fingerprints that agree with it ('for') and that disagree ('against').
+    """Per registered effect: the fingerprints that agree with it ('for') and that disagree ('against').
 
     sigma_db : repeat scatter of the magnitude off resonance (dB); sigma_f : relative
-    repeat scatter of f_res. A feature counts when it exceeds 3x its scatter.
+    repeat scatter of f_res. Each effect's own test (`jointcal.effects`, its ``fingerprint``)
+    says whether its feature is seen (a feature counts when it exceeds 3x its scatter); an
+    effect without one has no fingerprint for or against it.
     """
-    g = fp.get("low_gain")
-    gain_db = 20 * np.log10(g) if g else 0.0
-    tr = fp.get("low_gain_trend") or 0.0
-    dl = fp.get("delay_us") or 0.0
-    ft = fp.get("f_trend_per_decade") or 0.0
-    zt = fp.get("zeta_trend_per_decade") or 0.0
-    dr = fp.get("drift_sigma") or 0.0
-    ms = fp.get("masing_ratio") or 1.0
     h2, h3 = fp.get("h2_ratio") or 0.0, fp.get("h3_ratio") or 0.0
-    say = {
-        "sensor_gain": (abs(gain_db) > 3 * sigma_db, f"response/base far below resonance is {gain_db:+.2f} dB off the model"),
-        "channel_delay": (abs(dl) > 3.0, f"the phase error grows as 2 pi f tau with tau = {dl:.1f} us"),
-        "fixture_flexibility": (tr > 0.02, f"the low-frequency gain error rises with (f/f_res)^2 (slope {tr:.3f})"),
-        "cubic_stiffening": (abs(ft) > 3 * sigma_f, f"the frequency residual changes by {ft * 100:+.2f}% per decade of level"),
-        "quadratic_damping": (zt > 0.05 or ms > 1.3,
-                              f"the damping residual changes by {zt * 100:+.1f}% per decade of level; Masing ratio {ms:.2f}"),
-        "joint_settling": (abs(dr) > 3.0, f"the repeated runs drift by {dr:+.1f} scatter units over the sequence"),
-    }
     out = {}
-    for name, (hit, words) in say.items():
+    for name, effect in EFFECTS.items():
+        if effect.fingerprint is None:
+            out[name] = {"for": [], "against": []}
+            continue
+        hit, words = effect.fingerprint(fp, sigma_db, sigma_f)
         out[name] = {"for": [words] if hit else [], "against": [] if hit else [f"not seen: {words}"]}
     if h2 > 2 * max(h3, 1e-12):
         for name in out:

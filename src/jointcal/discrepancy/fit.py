@@ -14,7 +14,7 @@ So the fits do not mistake the sweep's lag, lower peak or ringing for an effect.
 
 A candidate is the baseline, one library effect, or several joined by '+' (present
 together). Parameters live in a unit cube: the calibration's space (`jointcal.calibrate.space`)
-grown by the effects' own parameters (`ParamSpace.grow` with `library.EffectParam`'s
+grown by the effects' own parameters (`ParamSpace.grow` with `jointcal.effects.EffectParam`'s
 bounds and scaling). Bounded least squares (`scipy.optimize.least_squares`) from
 the baseline calibration and from each of the effect's start values; the Jacobian is one
 batched call of the fast model over the perturbed parameter sets.
@@ -32,7 +32,7 @@ from scipy.optimize import least_squares
 from ..calibrate.space import PARAMS, ParamSpace
 from ..models import MinistackModel, quasi_steady, swept_transmissibility
 from .data import RunEnvelope, run_zeta
-from .library import EFFECTS, apply_effect, effects_of
+from ..effects import EFFECTS, apply_effect, effects_of
 
 __all__ = ["HELD", "Candidate", "Fit", "candidate", "model_at", "fit_candidate", "envelope_E", "predict",
            "with_transient"]

@@ -1,4 +1,5 @@
-"""Decide: refit the baseline and every library candidate, score them on runs they did not fit, name them.
+"""Score: refit the baseline and every library candidate, score them on runs they did not fit (the
+decision on those scores is `rule.decide`).
 
 Held-out score. For each tested level L (with at least two levels), every model is refit
 on the runs of the other levels (warm started from its fit on all runs) and its fast-model
@@ -25,7 +26,7 @@ their parameters (`pair_names`).
 
 The fast model's floor F (its own error against the time simulation of the calibrated model
 on the same runs and bins, `floor.fast_floor`) is taken out of the baseline's score before
-the 'none' test: S_b' = sqrt(max(S_b^2 - F^2, 0)).
+the 'none' test (`rule`).
 """
 from __future__ import annotations
 
@@ -36,32 +37,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .data import RunEnvelope
+from ..effects import JOIN
 from .fit import Candidate, Fit, envelope_E, fit_candidate, with_transient
-from .library import EFFECTS, JOIN, effects_of
+from .rule import MARGIN, NONE_E, _above_floor, _ranked, _within_scatter_drift
 
-__all__ = ["NONE_E", "CLOSE_FRACTION", "MARGIN", "PENALTY_PER_PARAM", "WITHIN_SCATTER", "FLOOR_HIGH", "Scored",
-           "score_candidates", "needs_pairs", "pair_bases", "pair_names", "decide", "confirm", "RULE"]
+__all__ = ["PENALTY_PER_PARAM", "Scored", "score_candidates", "needs_pairs", "pair_bases", "pair_names"]
 
-NONE_E = 1.5
-CLOSE_FRACTION = 0.6
-MARGIN = 0.7
 PENALTY_PER_PARAM = 0.02
-WITHIN_SCATTER = 0.5
-FLOOR_HIGH = 1.0  # a fast-model floor above this (the repeat scatter) caps every confidence at medium
-
-RULE = (f"Scores S are held-out fast-model E (1 = the repeat scatter), S_b the baseline's, F the fast model's "
-        f"floor. 'none' if sqrt(S_b^2 - F^2) <= {NONE_E} (unless the best single effect changes with the run "
-        f"sequence, whose drift inflates the repeat scatter, and scores <= {WITHIN_SCATTER} x S_b and <= {MARGIN} x "
-        "the runner-up: named, medium; forward selection then goes on from it, and a pair with it that scores "
-        f"<= {MARGIN} x it and x the next pair is named instead, medium). Otherwise a single effect is "
-        f"named if it closes >= {CLOSE_FRACTION:.0%} of the baseline's excess over 1 and scores <= {MARGIN} x "
-        f"the runner-up (high when its score <= 2). If the best single scores above {NONE_E}, effects are added "
-        f"to it one at a time (forward selection); a pair is named instead when it closes >= "
-        f"{CLOSE_FRACTION:.0%} of the excess, scores <= {MARGIN} x the best single and <= {MARGIN} x the next "
-        "pair (high when its score <= 2). Otherwise unexplained. A fingerprint no library effect leaves (a "
-        f"dominant even harmonic) keeps a name only at score <= 2, with confidence medium; a floor F > "
-        f"{FLOOR_HIGH} caps confidence at medium. A 'none' the time simulation contradicts (E > {NONE_E} before "
-        "and after the refit) becomes unexplained.")
 
 
 @dataclass
@@ -161,11 +143,6 @@ def score_candidates(cands: Sequence[Candidate], runs: Sequence[RunEnvelope], th
     return out
 
 
-def _ranked(scored: Sequence[Scored], pairs: bool) -> list[Scored]:
-    return sorted((s for s in scored if s.name != "baseline" and (len(effects_of(s.name)) > 1) == pairs),
-                  key=lambda s: s.score)
-
-
 def needs_pairs(scored: Sequence[Scored], floor: float = 0.0) -> bool:
     """Whether forward selection goes on to pairs: the baseline misses and no single effect brings the
     held-out score down to `NONE_E`; or the single named is a drift with the run sequence found within
@@ -198,82 +175,3 @@ def pair_names(scored: Sequence[Scored], library: Sequence[str]) -> list[str]:
                 seen.add(key)
                 out.append(f"{b}{JOIN}{e}")
     return out
-
-
-def _above_floor(score: float, floor: float) -> float:
-    return float(np.sqrt(max(score**2 - floor**2, 0.0)))
-
-
-def decide(scored: Sequence[Scored], outside: str | None = None, *, floor: float = 0.0
-           ) -> tuple[str, str, list[Scored]]:
-    """(effect(s) or 'none'/'unexplained', confidence, candidates ranked by score) by `RULE`.
-
-    scored : the baseline, single effects and any pairs ('a+b'). outside : a fingerprint no
-    library effect leaves (`fingerprints.outside_library`), or None. floor : the fast model's
-    own error F (E units).
-    """
-    base = next(s for s in scored if s.name == "baseline")
-    singles, pairs = _ranked(scored, False), _ranked(scored, True)
-    ranked = sorted(singles + pairs, key=lambda s: s.score)
-    s1 = singles[0].score if singles else np.inf
-    s2 = singles[1].score if len(singles) > 1 else np.inf
-    name, conf = _rule(base.score, s1, s2, singles, pairs, outside, floor)
-    if conf == "high" and floor > FLOOR_HIGH:
-        conf = "medium"
-    return name, conf, ranked
-
-
-def _drifts(name: str) -> bool:
-    """Whether the model changes with the run sequence: its drift inflates the repeat scatter it is judged by."""
-    return any(EFFECTS[e].sequence_dependent for e in effects_of(name))
-
-
-def _closes(sb: float, s: float) -> bool:
-    return sb - s >= CLOSE_FRACTION * (sb - 1.0)
-
-
-def _within_scatter_drift(sb: float, singles: Sequence[Scored], outside) -> bool:
-    """The within-scatter branch of the rule: the best single drifts with the sequence and halves the baseline."""
-    s1 = singles[0].score if singles else np.inf
-    s2 = singles[1].score if len(singles) > 1 else np.inf
-    return bool(singles) and _drifts(singles[0].name) and s1 <= WITHIN_SCATTER * sb and s1 <= MARGIN * s2 and not outside
-
-
-def _pair_wins(pairs: Sequence[Scored], s1: float) -> bool:
-    """The best pair beats the best single and the next pair by the margin."""
-    p1 = pairs[0].score
-    p2 = pairs[1].score if len(pairs) > 1 else np.inf
-    return p1 <= MARGIN * s1 and p1 <= MARGIN * p2
-
-
-def _rule(sb, s1, s2, singles, pairs, outside, floor) -> tuple[str, str]:
-    if _above_floor(sb, floor) <= NONE_E:
-        if _within_scatter_drift(sb, singles, outside):
-            if pairs and _drifts(pairs[0].name) and _pair_wins(pairs, s1):
-                return pairs[0].name, "medium"
-            return singles[0].name, "medium"
-        return "none", "high" if (not singles or s1 > 0.8 * sb) else "medium"
-    if pairs:
-        p1 = pairs[0].score
-        if _closes(sb, p1) and _pair_wins(pairs, s1) and not (outside and p1 > 2.0):
-            return pairs[0].name, "high" if (p1 <= 2.0 and not outside) else "medium"
-    if not singles:
-        return "unexplained", "low"
-    if _closes(sb, s1) and s1 <= MARGIN * s2 and not (outside and s1 > 2.0):
-        return singles[0].name, "high" if (s1 <= 2.0 and not outside) else "medium"
-    return "unexplained", "low"
-
-
-def confirm(effect: str, confidence: str, e_before: float, e_after: float) -> tuple[str, str, str | None]:
-    """The time simulation's word on a decision: (effect, confidence, note) by the end of `RULE`.
-
-    e_before, e_after : the time-domain E of the calibrated model and of the decided model
-    recalibrated. 'none' with both above `NONE_E` is contradicted (-> 'unexplained', note
-    'none_contradicted'); a name whose E does not fall, from above `NONE_E`, is not confirmed
-    (confidence 'low', note 'name_not_confirmed').
-    """
-    if effect == "none" and min(e_before, e_after) > NONE_E:
-        return "unexplained", "low", "none_contradicted"
-    if effect not in ("none", "unexplained") and e_after >= e_before and e_before > NONE_E:
-        return effect, "low", "name_not_confirmed"
-    return effect, confidence, None

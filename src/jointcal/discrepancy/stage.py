@@ -4,38 +4,39 @@
    time simulation of it on the same runs and bins (`floor.fast_floor`).
 1. Localise: the baseline (the calibration's optimum, refit on the envelopes) against
    the measured envelopes; residual map and fingerprints (`fingerprints`).
-2. Candidates: the baseline and every library effect (`library.EFFECTS`), each refit on
+2. Candidates: the baseline and every library effect (`jointcal.effects.library()`), each refit on
    the envelopes through the fast model (`fit`), scored on held-out levels (`select`);
    when no single effect brings the score to the scatter, pairs by forward selection.
-3. Decide by `select.decide`'s rule (`select.RULE`).
+3. Decide by `rule.decide` (`rule.RULE`), which returns the clauses that decided.
 4. Act: the named model recalibrated with the joint parameters (`recalibrate`:
    DEAP GA over the grown space seeded with the least-squares fits from the calibration's
    optimum and its other valleys, polish, emcee posterior for the 90% intervals),
    revalidated by the TIME simulation driven by each run's measured base record
    (`jointcal.validate.validate_runs`, the validation stage's E: same definition, same
    runs) -> metric_before, metric_after. A 'none' that the time simulation contradicts
-   (E above `select.NONE_E` before and after) becomes 'unexplained'; a name the time
+   (E above `rule.NONE_E` before and after) becomes 'unexplained'; a name the time
    simulation does not confirm (E not lower after) keeps confidence low.
 """
 from __future__ import annotations
 
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 import pandas as pd
 
 from ..calibrate.space import PARAMS, ParamSpace
+from ..effects import effects_of, library
 from ..models import harmonic_balance
 from ..validate import ValidateSettings, model_from_best, validate_runs
 from .data import run_envelope, scale_arrays
 from .fingerprints import fingerprints, outside_library, residual_map, verdicts
 from .fit import candidate, fit_candidate, model_at, with_transient
 from .floor import fast_floor
-from .library import EFFECTS, effects_of
 from .recalibrate import recalibrate
-from .select import RULE, confirm, decide, needs_pairs, pair_bases, pair_names, score_candidates
+from .rule import CLAUSES, confirm, decide
+from .select import needs_pairs, pair_bases, pair_names, score_candidates
 from .words import diagnosis_markdown
 
 __all__ = ["DiscrepancySettings", "diagnose", "diagnosis_markdown", "valley_starts"]
@@ -47,7 +48,7 @@ class DiscrepancySettings:
     max_frames per run, max_nfev of each least-squares fit, the recalibration's GA generations and
     posterior steps, and its seed."""
 
-    candidates: tuple[str, ...] = tuple(EFFECTS)
+    candidates: tuple[str, ...] = field(default_factory=library)
     band: tuple[float, float] = (0.6, 1.4)
     max_frames: int = 80
     max_nfev: int = 25
@@ -56,10 +57,10 @@ class DiscrepancySettings:
     seed: int = 2017
 
     def __post_init__(self) -> None:
-        bad = [c for c in self.candidates if c not in EFFECTS]
+        bad = [c for c in self.candidates if c not in library()]
         if bad:
             raise ValueError(f"discrepancy.candidates: unknown effect(s) {', '.join(bad)}; the library has "
-                             f"{', '.join(EFFECTS)}.")
+                             f"{', '.join(library())}.")
         if not (0 < self.band[0] < 1 < self.band[1]):
             raise ValueError(f"discrepancy.band must be [lo, hi] with 0 < lo < 1 < hi, got {list(self.band)!r}.")
         if self.ga_generations < 1 or self.posterior_steps < 100:
@@ -219,7 +220,8 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     fp = fingerprints(res, usable, model_fz, jb, max(scatter_f, 2e-5), m)
     ver = verdicts(fp, float(sdb[-1]), max(scatter_f, 2e-5))
     outside = outside_library(fp)
-    effect, confidence, ranked = decide(scored, outside, floor=F)
+    decision = decide(scored, outside, floor=F)
+    effect, confidence, ranked = decision.effect, decision.confidence, decision.ranked
     cand_out = [_candidate_json(s, space, m, ver) for s in ranked]
     # act: the named model, recalibrated and revalidated in the time domain
     named = next((s for s in ranked if s.name == effect), None)
@@ -252,7 +254,8 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     joint_after = {p: {"value": after[p], "interval_90": rec.interval(p)} for p in PARAMS}
     diagnosis = {
         "assembly": assembly, "effect": effect, "effects": list(effects_of(effect)) if effect not in (
-            "none", "unexplained") else [], "confidence": confidence, "rule": RULE,
+            "none", "unexplained") else [], "confidence": confidence, "rule": decision.rule,
+        "rule_applied": [*decision.applied, *([CLAUSES[time_note]] if time_note else [])],
         "outside_library": outside,
         "fast_model_floor": floor, "time_domain_check": time_note,
         "baseline": {"held_out_score": base.score, "E_fit": base.fit.E, "held_out_E_per_level": base.held_out,

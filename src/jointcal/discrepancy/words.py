@@ -19,8 +19,8 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from .library import EFFECTS
-from .select import NONE_E
+from ..effects import EFFECTS
+from .rule import NONE_E
 
 __all__ = ["diagnosis_markdown"]
 

@@ -1,7 +1,8 @@
 """Joint and structure models: exact Iwan, QSMA, harmonic balance, swept-sine simulator."""
 from .amplitude import G, harmonic_balance, jenkins_inphase, qsma, resonance_amplitude
 from .iwan import IwanParams, backbone, backbone_stiffness, derived, dissipation, force_history
-from .simulate import SimResult, fractional_delay, simulate
+from .elements import Element, contact_spring, cubic_spring, quadratic_damper
+from .simulate import SimResult, fractional_delay, integrate, simulate
 from .structure import Fixture, MinistackModel, state_space
 from .envelope import SteadyState, steady_state
 from .swept import SweepDrive, quasi_steady, swept_transmissibility
@@ -10,5 +11,6 @@ __all__ = [
     "G", "IwanParams", "derived", "backbone", "backbone_stiffness", "dissipation", "force_history",
     "qsma", "harmonic_balance", "jenkins_inphase", "resonance_amplitude",
     "MinistackModel", "Fixture", "SteadyState", "steady_state", "SweepDrive", "quasi_steady", "swept_transmissibility",
-    "state_space", "simulate", "SimResult", "fractional_delay",
+    "state_space", "simulate", "integrate", "SimResult", "fractional_delay",
+    "Element", "cubic_spring", "quadratic_damper", "contact_spring",
 ]

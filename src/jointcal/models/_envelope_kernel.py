@@ -6,7 +6,7 @@ scalar fixed point in s = log q (q the joint's relative amplitude, in):
     r(s) = s + log|K_z(q, omega) - mu(omega)| - log|B(omega)| = 0,
 
 with K_z the joint DOF's complex dynamic stiffness at amplitude q (linear spring,
-dashpot, Iwan describing function, cubic spring, quadratic damper) and mu, B the
+dashpot, Iwan describing function, the element table's describing functions) and mu, B the
 effective inertia and effective base load of the structure around it (a rigid base:
 mu = m omega^2, B = m A; a flexible fixture: see `envelope._structure_terms`). Stable
 branches have dr/ds > 0. The kernel marches over the frequencies in sweep order and
@@ -62,16 +62,27 @@ def _J(chi, smax, nodes, weights):
 
 
 @njit(cache=True, inline="always")
-def _stiffness(q, s, w, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights):
+def _cubic(q, a, re, dre):
+    """Cubic spring a z^3: 3/4 a q^2 in phase (added to re, and its q-slope to dre)."""
+    return re + 0.75 * a * q * q, dre + 2.0 * (0.75 * a * q * q)
+
+
+@njit(cache=True, inline="always")
+def _quadratic_damper(q, w, a, im, dim, C, C1):
+    """Quadratic damper a z'|z'|: omega c_eq with c_eq = 8 a omega q / (3 pi); C, C1 its omega-slopes."""
+    t = 8.0 * a * w * w * q / (3.0 * PI)
+    return im + t, dim + t, C + 16.0 * a * w * q / (3.0 * PI), C1 + 16.0 * a * q / (3.0 * PI)
+
+
+@njit(cache=True, inline="always")
+def _stiffness(q, s, w, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes, weights):
     """Complex dynamic stiffness of the joint DOF at amplitude q (in) and omega w (rad/s).
 
-    Returns (Re, Im, dRe/ds, dIm/ds) with s = log q (passed too: q^e = exp(e s)). kp: linear springs in parallel
-    (k); c: dashpot; Iwan (KT, R, chi, phimax, S; J1 = J(chi, 1)); k3 cubic; c2 quadratic.
+    Returns (Re, Im, dRe/ds, dIm/ds, C, C1) with s = log q (passed too: q^e = exp(e s)), C = dIm/domega at
+    fixed q (lbf s/in), C1 = dC/domega. kp: linear springs in parallel (k); c: dashpot; Iwan (KT, R, chi,
+    phimax, S; J1 = J(chi, 1)); codes (n_e,), coefs (n_e, 2): the element table (`models.elements`).
     """
-    re = kp
-    im = w * c
-    dre = 0.0
-    dim = 0.0
+    re, im, dre, dim = kp, w * c, 0.0, 0.0
     if KT > 0.0:
         e = chi + 1.0
         if q <= phimax:
@@ -98,22 +109,20 @@ def _stiffness(q, s, w, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights
             dD = 4.0 * R * u ** (chi + 2.0) / (chi + 2.0) + 4.0 * S * phimax  # dD/dq
             im += D / (PI * q * q)
             dim += (q * dD - 2.0 * D) / (PI * q * q)
-    if k3 != 0.0:
-        t = 0.75 * k3 * q * q  # cubic spring: 3/4 k3 q^2 in phase
-        re += t
-        dre += 2.0 * t
-    if c2 != 0.0:
-        t = 8.0 * c2 * w * w * q / (3.0 * PI)  # quadratic damper: omega c_eq, c_eq = 8 c2 omega q / (3 pi)
-        im += t
-        dim += t
-    return re, im, dre, dim
+    C, C1 = c, 0.0  # dIm/domega at fixed q, and its own omega-slope
+    for i in range(codes.shape[0]):  # the element table: one inline function per kind
+        if codes[i] == 1:  # cubic spring
+            re, dre = _cubic(q, coefs[i, 0], re, dre)
+        elif codes[i] == 3:  # quadratic damper
+            im, dim, C, C1 = _quadratic_damper(q, w, coefs[i, 0], im, dim, C, C1)
+    return re, im, dre, dim, C, C1
 
 
 @njit(cache=True, inline="always")
-def _residual(s, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights):
+def _residual(s, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes, weights):
     """r(s) and dr/ds of the amplitude fixed point."""
     q = np.exp(s)
-    re, im, dre, dim = _stiffness(q, s, w, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights)
+    re, im, dre, dim, _, _ = _stiffness(q, s, w, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes, weights)
     x = re - mu_re
     y = im - mu_im
     m2 = x * x + y * y
@@ -123,14 +132,14 @@ def _residual(s, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, k3, c2
 
 
 @njit(cache=True)
-def _root(s0, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights, tol):
+def _root(s0, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes, weights, tol):
     """A stable root of r near s0 (bracketed Newton), and whether the walk left a vanished branch.
 
     From s0 the search walks towards the sign change that r(s0) points to (down if
     r > 0, up if r < 0, as dr/ds > 0 on stable branches); a local extremum of r met on
     the way means the branch of s0 has ended at a fold (a jump).
     """
-    r0, d0, re, im = _residual(s0, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights)
+    r0, d0, re, im = _residual(s0, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes, weights)
     if abs(r0) < tol:
         return s0, False, re, im
     direction = -1.0 if r0 > 0.0 else 1.0
@@ -146,7 +155,7 @@ def _root(s0, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, k3, c2, n
     rb = ra
     for _ in range(200):
         b = a + direction * step
-        rb, db, re, im = _residual(b, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights)
+        rb, db, re, im = _residual(b, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes, weights)
         if abs(rb) < tol and not jumped:  # the Newton step from a continued guess has converged
             return b, False, re, im
         if rb * ra <= 0.0:
@@ -162,7 +171,7 @@ def _root(s0, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, k3, c2, n
     rlo = ra if a < b else rb
     s = b if abs(rb) < abs(ra) else a
     for _ in range(100):
-        r, dr, re, im = _residual(s, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights)
+        r, dr, re, im = _residual(s, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes, weights)
         if abs(r) < tol:
             return s, jumped, re, im
         if (r < 0.0) == (rlo < 0.0):
@@ -176,11 +185,11 @@ def _root(s0, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, k3, c2, n
         if hi - lo < tol:
             break
         s = sn
-    r, dr, re, im = _residual(s, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights)
+    r, dr, re, im = _residual(s, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes, weights)
     return s, jumped, re, im
 
 
-def _solve(w, mu_re, mu_im, logB, s_start, order, kp, c, KT, R, chi, phimax, S, J1, k3, c2,
+def _solve(w, mu_re, mu_im, logB, s_start, order, kp, c, KT, R, chi, phimax, S, J1, codes, coefs,
           nodes, weights, tol, s_out, jump_out, kre_out, kim_out):
     """Amplitudes s = log q (P, N) by continuation along `order` for every parameter set.
 
@@ -204,7 +213,7 @@ def _solve(w, mu_re, mu_im, logB, s_start, order, kp, c, KT, R, chi, phimax, S, 
                     guess = s + (s - s_prev) * (w[n] - w[n1]) / (w[n1] - w[n2])
             s_prev = s
             s, jumped, re, im = _root(guess, w[n], mu_re[p, n], mu_im[p, n], logB[p, n], kp[p], c[p], KT[p], R[p],
-                                      chi[p], phimax[p], S[p], J1[p], k3[p], c2[p], nodes, weights, tol)
+                                      chi[p], phimax[p], S[p], J1[p], codes, coefs[p], nodes, weights, tol)
             s_out[p, n] = s
             jump_out[p, n] = jumped and jj > 0
             kre_out[p, n] = re
@@ -230,42 +239,43 @@ def rigid_output(kre, kim, mu, mA, w, A, gain, tau, Z_out, T_out):
 
 
 @njit(cache=True)
-def stiffness_slopes(q, w, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights, out):
-    """K_z and its slopes at amplitudes q (P, N), omega w (N,); parameter arrays (P,).
+def stiffness_slopes(q, w, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes, weights, out):
+    """K_z and its slopes at amplitudes q (P, N), omega w (N,); parameter arrays (P,), coefs (P, n_e, 2).
 
-    Writes out (5, P, N): Re K_z, Im K_z, dRe/dlog q, dIm/dlog q (lbf/in) and dIm/domega
-    at fixed q (lbf s/in: the dashpot c and the quadratic damper's 16 c2 omega q / (3 pi)).
+    Writes out (6, P, N): Re K_z, Im K_z, dRe/dlog q, dIm/dlog q (lbf/in), C = dIm/domega at fixed q
+    (lbf s/in: the dashpot c and the quadratic damper's 16 a omega q / (3 pi)) and dC/domega.
     """
     P, N = q.shape
     for p in range(P):
         for n in range(N):
             qq = max(q[p, n], 1e-300)
-            re, im, dre, dim = _stiffness(qq, np.log(qq), w[n], kp[p], c[p], KT[p], R[p], chi[p], phimax[p], S[p],
-                                          J1[p], k3[p], c2[p], nodes, weights)
+            re, im, dre, dim, C, C1 = _stiffness(qq, np.log(qq), w[n], kp[p], c[p], KT[p], R[p], chi[p], phimax[p],
+                                                 S[p], J1[p], codes, coefs[p], nodes, weights)
             out[0, p, n] = re
             out[1, p, n] = im
             out[2, p, n] = dre
             out[3, p, n] = dim
-            out[4, p, n] = c[p] + 16.0 * c2[p] * w[n] * qq / (3.0 * PI)
+            out[4, p, n] = C
+            out[5, p, n] = C1
 
 
 @njit(cache=True, inline="always")
-def _flow(z, w, al, p0, g0, m1, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights):
+def _flow(z, w, al, p0, g0, m1, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes, weights):
     """Z' of the slow flow (m1 + C) Z' = g0 - (K_z(|Z|, w) + p0 + alpha C' / 2) Z, and the joint force.
 
-    C = dIm K_z / domega (dashpot, quadratic damper) turns the envelope's rate into force,
+    C = dIm K_z / domega (dashpot, dampers) turns the envelope's rate into force,
     C' = dC/domega its sweep term; the joint force is (K_z + alpha C' / 2) Z + C Z'.
     """
     q = max(abs(z), 1e-300)
-    re, im, dre, dim = _stiffness(q, np.log(q), w, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights)
-    C = c + 16.0 * c2 * w * q / (3.0 * PI)
-    kz = complex(re, im) + 0.5 * al * 16.0 * c2 * q / (3.0 * PI)
+    re, im, dre, dim, C, C1 = _stiffness(q, np.log(q), w, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes,
+                                         weights)
+    kz = complex(re, im) + 0.5 * al * C1
     zdot = (g0 - (kz + p0) * z) / (m1 + C)
     return zdot, kz * z + C * zdot
 
 
 @njit(cache=True)
-def slow_flow(z0, h, w, al, p0, g0, m1, kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes, weights, force_out):
+def slow_flow(z0, h, w, al, p0, g0, m1, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes, weights, force_out):
     """RK4 of the slow flow (`_flow`) from Z(0) = z0 for one parameter set.
 
     Nodes t_j = j h, j = 0 .. n-1; omega w, alpha al and the coefficients p0, g0, m1 are given
@@ -276,15 +286,15 @@ def slow_flow(z0, h, w, al, p0, g0, m1, kp, c, KT, R, chi, phimax, S, J1, k3, c2
     z = z0
     for j in range(n):
         i = 2 * j
-        k1, force = _flow(z, w[i], al[i], p0[i], g0[i], m1[i], kp, c, KT, R, chi, phimax, S, J1, k3, c2, nodes,
+        k1, force = _flow(z, w[i], al[i], p0[i], g0[i], m1[i], kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes,
                           weights)
         force_out[j] = force
         if j == n - 1:
             break
         k2, _ = _flow(z + 0.5 * h * k1, w[i + 1], al[i + 1], p0[i + 1], g0[i + 1], m1[i + 1], kp, c, KT, R, chi,
-                      phimax, S, J1, k3, c2, nodes, weights)
-        k3_, _ = _flow(z + 0.5 * h * k2, w[i + 1], al[i + 1], p0[i + 1], g0[i + 1], m1[i + 1], kp, c, KT, R, chi,
-                       phimax, S, J1, k3, c2, nodes, weights)
-        k4, _ = _flow(z + h * k3_, w[i + 2], al[i + 2], p0[i + 2], g0[i + 2], m1[i + 2], kp, c, KT, R, chi,
-                      phimax, S, J1, k3, c2, nodes, weights)
-        z = z + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3_ + k4)
+                      phimax, S, J1, codes, coefs, nodes, weights)
+        k3s, _ = _flow(z + 0.5 * h * k2, w[i + 1], al[i + 1], p0[i + 1], g0[i + 1], m1[i + 1], kp, c, KT, R, chi,
+                       phimax, S, J1, codes, coefs, nodes, weights)
+        k4, _ = _flow(z + h * k3s, w[i + 2], al[i + 2], p0[i + 2], g0[i + 2], m1[i + 2], kp, c, KT, R, chi,
+                      phimax, S, J1, codes, coefs, nodes, weights)
+        z = z + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3s + k4)

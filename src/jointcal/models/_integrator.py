@@ -69,17 +69,46 @@ def rate(u, fs):
     return ud
 
 
-@njit(cache=True)
-def run(u, ud, H, Gsub, Wub, Phi, Gf, lz, lv, az, bzu, bzf, cy, dyu, dyf,
-        joint, KT, R, chi, phimax, Fs, sk, sphi, k3, c2, kc, gap, y_out, z_out):
-    """Integrate from rest; write the output y and joint displacement z per input sample.
+@njit(cache=True, inline="always")
+def _element(code, a, b, z, v):
+    """Force of one element of the table (`jointcal.models.elements`) at z (in), z' (in/s).
 
-    joint: 0 none, 1 exact Iwan (R and chi passed as R/(chi+1), chi+1), 2 Jenkins
-    sliders of stiffness sk and slip displacement sphi (a test reference; KT = sum(sk)).
-    kc, gap: unilateral contact spring kc max(z - gap, 0) (0 disables it).
-    Gsub[j] (n, 4) maps the parent interval's Hermite data [u_k, H u'_k, u_k+1, H u'_k+1]
-    to the input's contribution over substep j; Wub[j] (4,) gives u at the substep's end.
+    Returns (force, dforce/dz, dforce/dz'). A new kind of element is one branch here.
     """
+    if code == 1:  # cubic spring a z^3
+        return a * z * z * z, 3.0 * a * z * z, 0.0
+    if code == 2:  # contact spring a max(z - b, 0)
+        if z > b:
+            return a * (z - b), a, 0.0
+        return 0.0, 0.0, 0.0
+    if code == 3:  # quadratic damper a z'|z'|
+        return a * v * abs(v), 0.0, 2.0 * a * abs(v)
+    return 0.0, 0.0, 0.0
+
+
+@njit(cache=True)
+def run(u, ud, maps, outputs, joint, sliders, elements, y_out, z_out):
+    """Integrate from rest; write the outputs y and the joint displacement z per input sample.
+
+    u, ud (N,): input and its rate; y_out (n_y, N), z_out (N,).
+    maps: (H, Gsub, Wub, Phi, Gf, lz, lv, az, bzu, bzf): sample interval H; Gsub[j] (n, 4)
+    maps the parent interval's Hermite data [u_k, H u'_k, u_k+1, H u'_k+1] to the input's
+    contribution over substep j, Wub[j] (4,) gives u at the substep's end; Phi, Gf the
+    substep's propagator and its map of the r_nl Hermite data; z = lz.x, z' = lv.x,
+    z'' = az.x + bzu u + bzf r_nl.
+    outputs: (cy (n_y, n), dyu (n_y,), dyf (n_y,)): y = cy.x + dyu u + dyf r_nl.
+    joint: (kind, KT, R, chi, phimax, Fs): kind 0 none, 1 exact Iwan (R and chi passed as
+    R/(chi+1), chi+1), 2 Jenkins sliders (a test reference; KT = sum of their stiffnesses).
+    sliders: (sk, sphi), the sliders' stiffnesses and slip displacements.
+    elements: (codes (n_e,), coefs (n_e, 2)), the element table sorted by code.
+    """
+    H, Gsub, Wub, Phi, Gf, lz, lv, az, bzu, bzf = maps
+    cy, dyu, dyf = outputs
+    jkind, KT, R, chi, phimax, Fs = joint
+    sk, sphi = sliders
+    codes, coefs = elements
+    n_el = codes.shape[0]
+    n_y = cy.shape[0]
     n_sub = Gsub.shape[0]
     n = Phi.shape[0]
     x = np.zeros(n)
@@ -100,7 +129,8 @@ def run(u, ud, H, Gsub, Wub, Phi, Gf, lz, lv, az, bzu, bzf, cy, dyu, dyf,
     have_prev = False
     h = H / n_sub
     N = u.shape[0]
-    y_out[0] = dyu * u[0]
+    for o in range(n_y):
+        y_out[o, 0] = dyu[o] * u[0]
     z_out[0] = 0.0
     for k in range(N - 1):
         p0 = u[k]
@@ -134,7 +164,7 @@ def run(u, ud, H, Gsub, Wub, Phi, Gf, lz, lv, az, bzu, bzf, cy, dyu, dyf,
             Fj = 0.0
             Kd = 0.0
             zp = z1
-            if joint != 0:
+            if jkind != 0:
                 turn = False
                 zt = 0.0
                 if d != 0 and v1 * d < 0.0:
@@ -143,7 +173,7 @@ def run(u, ud, H, Gsub, Wub, Phi, Gf, lz, lv, az, bzu, bzf, cy, dyu, dyf,
                 elif d != 0 and d * (z1 - z0) < 0.0:
                     turn = True
                     zt = z0
-                if joint == 1:
+                if jkind == 1:
                     F, K, ns, d = advance(su, sF, ns, d, z1, zt, turn, KT, R, chi, phimax, Fs)
                 else:
                     F = 0.0
@@ -169,19 +199,18 @@ def run(u, ud, H, Gsub, Wub, Phi, Gf, lz, lv, az, bzu, bzf, cy, dyu, dyf,
             for sweep in range(2):
                 r1 = Fj
                 rd1 = Kd * v1
-                if k3 != 0.0:
-                    r1 += k3 * z1 * z1 * z1
-                    rd1 += 3.0 * k3 * z1 * z1 * v1
-                if kc != 0.0 and z1 > gap:
-                    r1 += kc * (z1 - gap)
-                    rd1 += kc * v1
-                if c2 != 0.0:
+                cv = 0.0
+                for e in range(n_el):
+                    fe, kz, ce = _element(codes[e], coefs[e, 0], coefs[e, 1], z1, v1)
+                    r1 += fe
+                    rd1 += kz * v1
+                    cv += ce
+                if cv != 0.0:  # a damper: its rate needs z'' at the step's end, from the total r_nl
                     ub = Wub[j, 0] * p0 + Wub[j, 1] * p1 + Wub[j, 2] * p2 + Wub[j, 3] * p3
-                    r1 += c2 * v1 * abs(v1)
                     zdd = bzu * ub + bzf * r1
                     for i in range(n):
                         zdd += az[i] * (xl[i] + Gf[i, 2] * r1 + Gf[i, 3] * h * rd1)
-                    rd1 += 2.0 * c2 * abs(v1) * zdd
+                    rd1 += cv * zdd
                 if sweep == 1:
                     break
                 # correct the state with the evaluated r_nl, then move the joint force to the
@@ -201,8 +230,9 @@ def run(u, ud, H, Gsub, Wub, Phi, Gf, lz, lv, az, bzu, bzf, cy, dyu, dyf,
             rd0 = rd1
             z0 = z1
             v0 = v1
-        s = dyu * u[k + 1] + dyf * r0
-        for i in range(n):
-            s += cy[i] * x[i]
-        y_out[k + 1] = s
+        for o in range(n_y):
+            s = dyu[o] * u[k + 1] + dyf[o] * r0
+            for i in range(n):
+                s += cy[o, i] * x[i]
+            y_out[o, k + 1] = s
         z_out[k + 1] = z0

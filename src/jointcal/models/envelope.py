@@ -7,7 +7,8 @@ replaced by its describing function at q (PHYSICS.md):
 * Iwan joint (eqs. 3.3-3.7): in-phase stiffness KT - R q^(chi+1) J - S (1 - g(phi_max/q))
   (the last term past macroslip) and energy-equivalent damping, i omega c_eq with
   omega c_eq = D(q) / (pi q^2);
-* cubic spring k3 z^3: + 3/4 k3 q^2;  quadratic damper c2 z'|z'|: omega c_eq = 8 c2 omega^2 q / (3 pi);
+* elements (`jointcal.models.elements`): cubic spring a z^3, + 3/4 a q^2; quadratic damper
+  a z'|z'|, omega c_eq = 8 a omega^2 q / (3 pi);
 * linear spring k and dashpot c = 2 zeta_v sqrt((k + KT) m).
 
 The structure around the joint DOF is linear and exact: on a rigid base
@@ -18,10 +19,10 @@ point q = |gamma| m A / |K_z(q) - mu|, up to three solutions near a softening fo
 stable). The measured channel is the slug's absolute acceleration through the sensor:
 T = gain * (1 - omega^2 (W + Z) / A) * exp(-i omega tau).
 
-Every named effect of `MinistackModel` enters here and in the time integrator from the
-same fields: a new effect is a field of the model, a term in `_stiffness` (nonlinear,
-joint DOF) or in `_structure_terms` (linear structure, sensor), and a term in
-`_integrator`.
+Every named effect (`jointcal.effects`) enters here and in the time integrator from the
+same fields of `MinistackModel`: the structure (`_structure_terms`), the sensor, and the
+element table of the joint DOF (`jointcal.models.elements`), whose describing functions
+are inline functions of `_envelope_kernel` (one per kind of element).
 """
 from __future__ import annotations
 
@@ -33,6 +34,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _envelope_kernel as _k
 from .amplitude import G, _J
+from .elements import FIRST_HARMONIC, NAMES, element_table
 from .iwan import derived
 from .structure import MinistackModel
 
@@ -78,7 +80,8 @@ def _field(value, shape) -> NDArray[np.float64]:
 def _batch_shape(model: MinistackModel, f_shape: tuple) -> tuple[tuple[int, int], tuple]:
     """(P, N) of a model's parameter batch along frequencies of shape f_shape, and the broadcast output shape."""
     iw = model.iwan
-    fields = [model.m, model.k, model.zeta_v, model.k3, model.c2, model.sensor_gain, model.sensor_delay_s]
+    fields = [model.m, model.k, model.zeta_v, model.sensor_gain, model.sensor_delay_s]
+    fields += [v for e in model.elements for v in (e.a, e.b)]
     if iw is not None:
         fields += [iw.Fs, iw.KT, iw.chi, iw.beta]
     if model.fixture is not None:
@@ -88,14 +91,15 @@ def _batch_shape(model: MinistackModel, f_shape: tuple) -> tuple[tuple[int, int]
 
 
 def _joint_terms(model: MinistackModel, shape) -> tuple[NDArray, ...]:
-    """The joint DOF's kernel parameters, each (P,): k, c, KT, R, chi, phi_max, S, J(chi, 1), k3, c2.
+    """The joint DOF's kernel parameters: k, c, KT, R, chi, phi_max, S, J(chi, 1), each (P,), and the
+    element table: codes (n_e,), coefficients (P, n_e, 2).
 
     c = 2 zeta_v sqrt((k + KT) m) is the dashpot (lbf s/in); R, S, phi_max the Iwan density
     parameters (`iwan.derived`); a linear model has KT = 0.
     """
     P = shape[0]
     m, k, zv = (_field(v, shape) for v in (model.m, model.k, model.zeta_v))
-    k3, c2 = _field(model.k3, shape), _field(model.c2, shape)
+    codes, coefs = element_table(model.elements, lambda v: _field(v, shape))
     iw = model.iwan
     if iw is None:
         KT = np.zeros(P)
@@ -107,7 +111,7 @@ def _joint_terms(model: MinistackModel, shape) -> tuple[NDArray, ...]:
         phimax, R, S = derived(Fs, KT, chi, beta)
         J1 = _J(chi, np.ones_like(chi))
     c = 2.0 * zv * np.sqrt((k + KT) * m)
-    return k, c, KT, R, chi, phimax, S, J1, k3, c2
+    return k, c, KT, R, chi, phimax, S, J1, codes, coefs
 
 
 def _amplitudes(f: NDArray, A: NDArray, direction: str, shape, joint, m: NDArray, mu: NDArray,
@@ -119,7 +123,7 @@ def _amplitudes(f: NDArray, A: NDArray, direction: str, shape, joint, m: NDArray
     """
     P = shape[0]
     w = 2 * np.pi * f
-    k, c, KT, R, chi, phimax, S, J1, k3, c2 = joint
+    k, c, KT, R, chi, phimax, S, J1, codes, coefs = joint
     rigid = gamma is None
     logB = np.log(m[:, None] * A) + (0.0 if rigid else np.log(np.abs(gamma)))
     order = np.argsort(f, kind="stable")
@@ -136,7 +140,7 @@ def _amplitudes(f: NDArray, A: NDArray, direction: str, shape, joint, m: NDArray
     mu_re = np.ascontiguousarray(mu.real)
     mu_im = np.zeros_like(mu_re) if rigid else np.ascontiguousarray(mu.imag)
     solver(w, mu_re, mu_im, np.ascontiguousarray(np.broadcast_to(logB, (P, f.size))), s0,
-           order.astype(np.int64), k, c, KT, R, chi, phimax, S, J1, k3, c2, _NODES, _WEIGHTS, TOL, s, jump,
+           order.astype(np.int64), k, c, KT, R, chi, phimax, S, J1, codes, coefs, _NODES, _WEIGHTS, TOL, s, jump,
            kre, kim)
     return s, jump, kre, kim
 
@@ -159,6 +163,23 @@ def _structure_terms(model: MinistackModel, w: NDArray, shape) -> tuple[NDArray,
     kc = k_can + 1j * w * c_can
     a11 = kc - w**2 * (m_can + m)
     return w**2 * m * (1.0 + w**2 * m / a11), kc / a11
+
+
+def _checked(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike, direction: str) -> tuple[NDArray, NDArray]:
+    """Frequencies f (N,), Hz, and base amplitudes A (N,), in/s^2; one sentence for each bad input."""
+    if direction not in ("up", "down"):
+        raise ValueError(f"direction must be 'up' or 'down', got {direction!r}.")
+    f = np.atleast_1d(np.asarray(f_hz, dtype=float))
+    if f.ndim != 1 or not np.all(np.isfinite(f) & (f > 0)):
+        raise ValueError("steady_state: f_hz must be a 1-D array of positive, finite frequencies in Hz.")
+    A = np.broadcast_to(np.asarray(base_g, dtype=float), f.shape) * G
+    if not np.all(np.isfinite(A) & (A > 0)):
+        raise ValueError("steady_state: base_g must be positive and finite (g) at every frequency.")
+    other = [NAMES[e.code] for e in model.elements if e.code not in FIRST_HARMONIC]
+    if other:
+        raise ValueError(f"steady_state has no first-harmonic model of a {', '.join(other)} (a unilateral contact: "
+                         "its response has a mean offset and even harmonics); use jointcal.models.simulate.")
+    return f, A
 
 
 def steady_state(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike = 1.0, *,
@@ -192,17 +213,7 @@ def steady_state(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike = 1.0
     continued from the neighbouring frequency), so it is an exact describing-function
     solution, not a grid value; dashpot convention as `harmonic_balance(viscous="dashpot")`.
     """
-    if direction not in ("up", "down"):
-        raise ValueError(f"direction must be 'up' or 'down', got {direction!r}.")
-    f = np.atleast_1d(np.asarray(f_hz, dtype=float))
-    if f.ndim != 1 or not np.all(np.isfinite(f) & (f > 0)):
-        raise ValueError("steady_state: f_hz must be a 1-D array of positive, finite frequencies in Hz.")
-    A = np.broadcast_to(np.asarray(base_g, dtype=float), f.shape) * G
-    if not np.all(np.isfinite(A) & (A > 0)):
-        raise ValueError("steady_state: base_g must be positive and finite (g) at every frequency.")
-    if np.any(np.asarray(model.contact_k) != 0):
-        raise ValueError("steady_state has no first-harmonic model of a unilateral contact (contact_k > 0): its "
-                         "response has a mean offset and even harmonics; use jointcal.models.simulate.")
+    f, A = _checked(model, f_hz, base_g, direction)
     shape, out_shape = _batch_shape(model, f.shape)
     P = shape[0]
     w = 2 * np.pi * f

@@ -4,7 +4,9 @@
 synthetic) and returns the response accelerometer's signal at the input samples.
 The joint force is the exact Iwan hysteresis (turning-point rules, no sliders); the
 linear structure is propagated exactly (zero natural-frequency error at any step);
-see `jointcal.models._integrator` for the scheme.
+see `jointcal.models._integrator` for the scheme. `integrate` runs the same scheme on any
+linear system with one joint DOF (e.g. a structure coupled to a shaker,
+`jointcal.synth.shaker`).
 """
 from __future__ import annotations
 
@@ -15,13 +17,17 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.linalg import expm
 from scipy.signal import resample_poly
 
+from collections.abc import Sequence
+
 from . import _integrator
 from .amplitude import G
 from ._masing import kernel_constants
-from .iwan import derived
-from .structure import MinistackModel, state_space
+from .elements import CONTACT_SPRING, Element, element_table
+from .iwan import IwanParams, derived
+from .structure import MinistackModel, StateSpace, state_space
 
-__all__ = ["SimResult", "simulate", "hermite_propagator", "fractional_delay", "substeps", "band_limited"]
+__all__ = ["SimResult", "simulate", "integrate", "hermite_propagator", "fractional_delay", "substeps",
+           "band_limited"]
 
 
 @dataclass(frozen=True)
@@ -61,8 +67,9 @@ def substeps(model: MinistackModel, fs: float, omega_h: float = 0.65) -> int:
     follow (measured on a bilinear oscillator at omega_2 h = 0.5: 27% amplitude lost over
     700 undamped cycles; at omega_2 h = 0.13, 0.08%).
     """
-    if np.any(np.asarray(model.contact_k) > 0):
-        w = np.sqrt((model.k + model.KT + model.contact_k) / model.m)
+    kc = sum(float(e.a) for e in model.elements if e.code == CONTACT_SPRING)
+    if kc > 0:
+        w = np.sqrt((model.k + model.KT + kc) / model.m)
         return max(1, int(np.ceil(4.0 * w / (omega_h * fs))))
     return max(1, int(np.ceil(2 * np.pi * model.f0_hz / (omega_h * fs))))
 
@@ -166,34 +173,74 @@ def simulate(model: MinistackModel, base_accel_g: ArrayLike, fs: float, *,
         u, U = band_limited(u, fs, model.f0_hz, samples_per_cycle)
         fs = fs * U
     n_sub = substeps(model, fs, omega_h) if n_sub is None else int(n_sub)
-    ss = state_space(model)
-    H = 1.0 / fs
-    h = H / n_sub
-    Phi, Gu = hermite_propagator(ss.A, ss.bu, h)
-    _, Gf = hermite_propagator(ss.A, ss.bf, h)
-    Gsub, Wub = _substep_maps(Gu, n_sub)
-    az = ss.lv @ ss.A
-    bzu = float(ss.lv @ ss.bu)
-    bzf = float(ss.lv @ ss.bf)
-    sk = sphi = np.zeros(0)
-    if model.iwan is None:
-        joint, KT, R, chi, phimax, Fs = 0, 0.0, 0.0, 0.5, 1.0, 0.0
-    elif sliders is not None:
-        sk, sphi = (np.ascontiguousarray(a, dtype=float) for a in sliders)
-        joint, KT, R, chi, phimax, Fs = 2, float(sk.sum()), 0.0, 0.5, 1.0, 0.0
-    else:
-        p = model.iwan
-        phimax, R, _ = (float(a) for a in derived(p.Fs, p.KT, p.chi, p.beta))
-        R, chi = kernel_constants(R, p.chi)
-        joint, KT, Fs = 1, p.KT, p.Fs
-    y = np.empty_like(u)
-    z = np.empty_like(u)
-    _integrator.run(u, _integrator.rate(u, fs), H, Gsub, Wub, np.ascontiguousarray(Phi), np.ascontiguousarray(Gf), ss.lz, ss.lv, az, bzu, bzf,
-                    ss.cy, ss.dyu, ss.dyf, joint, KT, R, chi, phimax, Fs, sk, sphi,
-                    float(model.k3), float(model.c2), float(model.contact_k), float(model.contact_gap_in), y, z)
+    Y, z = integrate(state_space(model), u, fs, n_sub, iwan=model.iwan, sliders=sliders, elements=model.elements)
+    y = Y[0]
     if U > 1:
         y, z, fs = y[::U][:n_out].copy(), z[::U][:n_out].copy(), fs / U
     if model.sensor_delay_s != 0.0:
         y = fractional_delay(y, model.sensor_delay_s, fs)
     y *= model.sensor_gain / G
     return SimResult(response_g=y, z_in=z, n_sub=n_sub * U)
+
+
+def _joint(iwan: IwanParams | None, sliders: tuple[NDArray, NDArray] | None):
+    """The kernel's joint and slider arguments: (kind, KT, R, chi, phimax, Fs), (sk, sphi)."""
+    none = (np.zeros(0), np.zeros(0))
+    if sliders is not None:
+        sk, sphi = (np.ascontiguousarray(a, dtype=float) for a in sliders)
+        return (2, float(sk.sum()), 0.0, 0.5, 1.0, 0.0), (sk, sphi)
+    if iwan is None:
+        return (0, 0.0, 0.0, 0.5, 1.0, 0.0), none
+    phimax, R, _ = (float(a) for a in derived(iwan.Fs, iwan.KT, iwan.chi, iwan.beta))
+    R, chi = kernel_constants(R, iwan.chi)
+    return (1, float(iwan.KT), float(R), float(chi), phimax, float(iwan.Fs)), none
+
+
+def integrate(ss: StateSpace, u: NDArray, fs: float, n_sub: int, *, iwan: IwanParams | None = None,
+              sliders: tuple[NDArray, NDArray] | None = None, elements: Sequence[Element] = (),
+              outputs: Sequence[tuple[NDArray, float, float]] | None = None) -> tuple[NDArray, NDArray]:
+    """Integrate x' = A x + bu u + bf r_nl from rest (the scheme of `jointcal.models._integrator`).
+
+    Parameters
+    ----------
+    ss : StateSpace
+        The linear system with the joint stuck (stiffness KT in A); z = lz.x is the joint DOF.
+    u : ndarray, shape (N,)
+        Input at the samples (the units of bu: in/s^2 for a base acceleration, V for a drive).
+    fs : float
+        Sample rate of u, Hz.
+    n_sub : int
+        Integration substeps per sample.
+    iwan : IwanParams, optional
+        The joint (exact Iwan hysteresis); None: no joint.
+    sliders : (k, phi), optional
+        Jenkins sliders in place of the Iwan joint (lbf/in, in): a test reference.
+    elements : sequence of Element
+        Nonlinear elements in parallel with the joint (`jointcal.models.elements`).
+    outputs : sequence of (c (n,), du, df), optional
+        Output channels y = c.x + du u + df r_nl; default the system's own (cy, dyu, dyf).
+
+    Returns
+    -------
+    Y : ndarray, shape (n_outputs, N)
+        The outputs at the samples.
+    z : ndarray, shape (N,)
+        The joint DOF at the samples.
+    """
+    u = np.ascontiguousarray(u, dtype=float)
+    outputs = [(ss.cy, ss.dyu, ss.dyf)] if outputs is None else list(outputs)
+    h = 1.0 / fs / n_sub
+    Phi, Gu = hermite_propagator(ss.A, ss.bu, h)
+    _, Gf = hermite_propagator(ss.A, ss.bf, h)
+    Gsub, Wub = _substep_maps(Gu, n_sub)
+    az = ss.lv @ ss.A
+    maps = (1.0 / fs, Gsub, Wub, np.ascontiguousarray(Phi), np.ascontiguousarray(Gf),
+            np.ascontiguousarray(ss.lz, dtype=float), np.ascontiguousarray(ss.lv, dtype=float),
+            np.ascontiguousarray(az, dtype=float), float(ss.lv @ ss.bu), float(ss.lv @ ss.bf))
+    outs = (np.ascontiguousarray(np.array([np.asarray(c, float) for c, _, _ in outputs])),
+            np.array([float(d) for _, d, _ in outputs]), np.array([float(d) for _, _, d in outputs]))
+    joint, sl = _joint(iwan, sliders)
+    Y = np.empty((len(outputs), u.size))
+    z = np.empty_like(u)
+    _integrator.run(u, _integrator.rate(u, fs), maps, outs, joint, sl, element_table(elements), Y, z)
+    return Y, z

@@ -11,10 +11,13 @@ frequency). Coordinates are relative to the control accelerometer (the base):
 
 M q'' + C q' + K q = -M_b a_base - e_z r_nl, where K holds the STUCK joint stiffness
 KT and r_nl is the nonlinear remainder of the joint restoring force,
-r_nl = F_iwan(z) - KT z + k3 z^3 + c2 z'|z'| + k_c max(z - gap, 0). The response channel is the slug's
-absolute acceleration a_base + s.q''. Adding an effect means adding a field here and
-its terms to `state_space` (linear) or to r_nl (nonlinear); the integrator does not
-change. Sensor effects (gain, delay) act on the output channel after integration.
+r_nl = F_iwan(z) - KT z + the forces of `elements` (`jointcal.models.elements`: a cubic
+spring, a quadratic damper, a contact spring). The response channel is the slug's
+absolute acceleration a_base + s.q''. An effect changes the model through these fields
+(`jointcal.effects`): a linear one through the structure (`fixture`, assembled in
+`state_space`), a nonlinear one by adding an element (the kernels read the element
+table: a new kind of element is one inline function in each kernel, and no change of
+their signatures), a sensor one (gain, delay) on the output channel after integration.
 """
 from __future__ import annotations
 
@@ -22,6 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .elements import Element
 from .iwan import IwanParams
 
 __all__ = ["Fixture", "MinistackModel", "StateSpace", "state_space"]
@@ -56,20 +60,15 @@ class MinistackModel:
         The joint; None gives the linear model with stiffness k.
     fixture : Fixture or None
         Flexible can DOF (named effect ``fixture_flexibility``).
-    k3 : float
-        Cubic spring in parallel with the joint, lbf/in^3 (``cubic_stiffening``).
-    c2 : float
-        Quadratic damper c2 z'|z'|, lbf s^2/in^2 (``quadratic_damping``).
+    elements : tuple of Element
+        Nonlinear elements in parallel with the joint (`jointcal.models.elements`): a cubic
+        spring (``cubic_stiffening``), a quadratic damper (``quadratic_damping``), a
+        unilateral contact spring (a stop, a bottomed foam cup: only the time simulation
+        models it).
     sensor_gain : float
         Response-channel sensitivity error factor (``sensor_gain``).
     sensor_delay_s : float
         Response-channel delay, s (``channel_delay``).
-    contact_k : float
-        Unilateral contact spring, lbf/in: force contact_k max(z - contact_gap_in, 0)
-        once the slug closes a gap (a stop, a bottomed foam cup). Not in the discrepancy
-        library (a test of an effect outside it); only the time simulation models it.
-    contact_gap_in : float
-        Gap the slug closes before the contact spring engages, in (>= 0).
     """
 
     m: float
@@ -77,12 +76,9 @@ class MinistackModel:
     zeta_v: float
     iwan: IwanParams | None = None
     fixture: Fixture | None = None
-    k3: float = 0.0
-    c2: float = 0.0
+    elements: tuple[Element, ...] = ()
     sensor_gain: float = 1.0
     sensor_delay_s: float = 0.0
-    contact_k: float = 0.0
-    contact_gap_in: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("m", "k"):
@@ -93,9 +89,8 @@ class MinistackModel:
             raise ValueError(f"MinistackModel.zeta_v must lie in [0, 1), got {self.zeta_v!r}.")
         if not np.all(np.asarray(self.sensor_gain) > 0):
             raise ValueError(f"sensor_gain must be positive, got {self.sensor_gain!r}.")
-        if not np.all((np.asarray(self.contact_k) >= 0) & (np.asarray(self.contact_gap_in) >= 0)):
-            raise ValueError("contact_k and contact_gap_in must be >= 0 (a contact that pushes back once the gap "
-                             f"closes), got {self.contact_k!r} and {self.contact_gap_in!r}.")
+        if not all(isinstance(e, Element) for e in self.elements):
+            raise ValueError(f"MinistackModel.elements must be a tuple of Element, got {self.elements!r}.")
 
     @property
     def KT(self) -> float:

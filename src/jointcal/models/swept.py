@@ -159,11 +159,10 @@ def _quasi_steady(model: MinistackModel, f: NDArray, base_g: NDArray, rate: NDAr
     Kz = kre + 1j * kim
     D = Kz - mu
     Z0 = F * A / D
-    slopes = np.empty((5, P, N))
+    slopes = np.empty((6, P, N))
     _k.stiffness_slopes(q, w, *joint, _NODES, _WEIGHTS, slopes)
     Ks, dKw = slopes[2] + 1j * slopes[3], 1j * slopes[4]
-    C = slopes[4]  # dIm K_z / domega: the dashpots turn the envelope's rate into force
-    C1 = (C - joint[1][:, None]) / w  # its own omega-slope (the quadratic damper's)
+    C, C1 = slopes[4], slopes[5]  # dIm K_z / domega (the dashpots turn the envelope's rate into force), its slope
     alpha = 2 * np.pi * np.broadcast_to(np.asarray(rate, float), f.shape)
     dl = np.broadcast_to(np.asarray(dlog, float), f.shape)
     with np.errstate(all="ignore"):
@@ -248,7 +247,6 @@ def swept_transmissibility(model: MinistackModel, drive: SweepDrive, t_s: ArrayL
     f_o, b_o, r_o, dl_o = drive.at(t_out)
     rate = float(np.median(drive.rates[0]))
     direction = "up" if rate >= 0 else "down"
-    shape = (1, t_out.size)
     R, _, A = _quasi_steady(model, f_o, b_o, r_o, dl_o, direction)
     T = (R / A)[0]
     eta = sweep_eta(rate, f_res_hz, zeta)
@@ -266,7 +264,7 @@ def swept_transmissibility(model: MinistackModel, drive: SweepDrive, t_s: ArrayL
         if keep.any():
             T[keep] = _integrated(model, drive, t_a, t_b, ka, t_out[keep], direction,
                                   2 * np.pi * f_res_hz * zeta, max(span, after))
-    return T * _sensor(model, f_o, shape)[0]
+    return T * _sensor(model, f_o, (1, t_out.size))[0]
 
 
 def _integrated(model: MinistackModel, drive: SweepDrive, t_a: float, t_b: float, ka: int, t_out: NDArray,
@@ -287,7 +285,8 @@ def _integrated(model: MinistackModel, drive: SweepDrive, t_a: float, t_b: float
     p0 = np.ascontiguousarray(-mu + 0.5j * alpha * mu2)
     g0 = np.ascontiguousarray(F * A - 1j * F1 * A * dl - 0.5j * alpha * F2 * A)
     m1 = np.ascontiguousarray(1j * mu1 + 0j)
-    joint = tuple(float(v[0]) for v in _joint_terms(model, (1, 1)))
+    *scalars, codes, coefs = _joint_terms(model, (1, 1))
+    joint = (*(float(v[0]) for v in scalars), codes, np.ascontiguousarray(coefs[0]))
     force = np.empty(n, complex)
     _k.slow_flow(complex(Z[0, -1]), h, w, alpha, p0, g0, m1, *joint, _NODES, _WEIGHTS, force)
     m = float(_field(model.m, (1, 1))[0])

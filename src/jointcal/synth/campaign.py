@@ -15,13 +15,15 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from dataclasses import fields, replace
+from dataclasses import replace
 
+from ..effects import EFFECTS
 from ..io import write_csv_atomic, write_json_atomic, write_run
 from ..models import G, resonance_amplitude, simulate
 from . import daq
-from .effects import effect_defaults, run_model
-from .shaker import Shaker, StructureMode, rig_truth, simulate_rig
+from .hidden import effect_defaults, run_model
+from .rig_truth import rig_truth
+from .shaker import Shaker, StructureMode, simulate_rig
 from .spec import JOINT_KEYS, RIG_LEVEL, load_spec
 
 __all__ = ["generate", "plan_runs"]
@@ -82,16 +84,13 @@ _PLACEHOLDER_JOINT = {"Fs": 1.0, "KT": 1.0, "chi": -0.5, "beta": 0.1}
 
 def _model(truth: dict, sequence: int, effect: str, eparams: dict, also: dict | None = None):
     """The run's model: `run_model`, or its linear version for an assembly without a joint; with
-    `also` ({name, params}) the second effect's fields are laid over the first's."""
+    `also` ({name, params}) the second effect is applied to the first's model."""
     joint = all(k in truth for k in JOINT_KEYS)
     t = truth if joint else {**truth, **_PLACEHOLDER_JOINT}
     model = run_model(t, sequence, effect, eparams)
-    if also:
-        plain = run_model(t, sequence, "none", {})
-        second = run_model(t, sequence, also["name"], effect_defaults(also["name"], also.get("params")))
-        changed = {f.name: getattr(second, f.name) for f in fields(second)
-                   if getattr(second, f.name) != getattr(plain, f.name)}
-        model = replace(model, **changed)
+    if also and also["name"] != "none":
+        model = EFFECTS[also["name"]].apply(model, effect_defaults(also["name"], also.get("params")),
+                                            {"sequence": sequence})
     return model if joint else replace(model, iwan=None)
 
 

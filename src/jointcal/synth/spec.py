@@ -42,7 +42,7 @@ from pathlib import Path
 
 import yaml
 
-from .effects import effect_defaults
+from .hidden import effect_defaults
 from .shaker import Shaker, StructureMode
 
 __all__ = ["DEFAULT_SPEC", "load_spec"]
@@ -194,6 +194,8 @@ def load_spec(spec: dict | str | os.PathLike) -> dict:
             raise ValueError(f"{where}: effect.also must be a mapping {{name, params}} naming a second effect.")
         s["effect"]["also"] = {"name": also["name"], "params": also.get("params") or {}}
         effect_defaults(also["name"], s["effect"]["also"]["params"])
+        if also["name"] == s["effect"]["name"]:
+            raise ValueError(f"{where}: effect.also names {also['name']!r} again; hide a different second effect.")
     _coerce(s, where)
     effect_defaults(s["effect"]["name"], s["effect"]["params"])
     if s["file_format"] not in ("csv", "csv.gz", "mat"):
