@@ -19,8 +19,8 @@ from jointcal._checks import clip_levels, clipped_mask
 from jointcal.calibrate.data import select_modal
 from jointcal.cli import main
 from jointcal.io import CampaignError, CampaignWarning, ingest_campaign, listed_record, read_run, validate_run
+from jointcal.units import G_SI  # m/s^2 per g
 
-G_SI = 9.80665  # m/s^2 per g
 
 
 def _one_sentence(msg: str, *words: str) -> None:

@@ -16,8 +16,8 @@ from nptdms import ChannelObject, GroupObject, TdmsWriter
 
 from jointcal.io import CampaignError, ingest_campaign, read_manifest, read_run
 from jointcal.modal import measure_run
+from jointcal.units import G_SI  # m/s^2 per g
 
-G_SI = 9.80665  # m/s^2 per g
 EXAMPLE_RUN = "first_01_1g_up"
 NAMES = {"base_accel_g": "Ctrl Z", "drive_V": "Amp out", "response_accel_g": "Slug Z"}
 QUANTITY = {"base_accel_g": "Acceleration", "drive_V": "Voltage", "response_accel_g": "Acceleration"}

@@ -25,8 +25,8 @@ from jointcal._amplitudes import low_frequency_ratio
 from jointcal._checks import _check_time, time_resolution
 from jointcal.cli import main
 from jointcal.io import CampaignError, CampaignWarning, ingest_campaign, read_manifest, read_run, validate_run
+from jointcal.units import G_SI  # m/s^2 per g
 
-G_SI = 9.80665  # m/s^2 per g
 RUN, OTHER = "first_01_1g_up", "first_07_2g_up"  # a 1 g up sweep and a 2 g one, from raw_data/
 FILE = f"runs/{RUN}.csv.gz"
 

@@ -19,6 +19,7 @@ from jointcal.calibrate import CalibrateSettings, run_calibration
 from jointcal.io import read_manifest, read_run, write_csv_atomic
 from jointcal.modal import measure_run
 from jointcal.models import MinistackModel, simulate
+from jointcal.units import G
 from jointcal.synth import generate
 from jointcal.synth.effects import run_model
 from jointcal.validate import (
@@ -27,7 +28,7 @@ from jointcal.validate import (
 )
 
 TRUTH = {"Fs": 313.0, "KT": 1.02e6, "chi": -0.65, "beta": 0.004, "k": 6.12e5, "zeta_v": 0.0015}
-M = 2.65 / 386.089
+M = 2.65 / G
 
 
 def _sweep_record(fs=12800.0, f0=1500.0, f1=3000.0, rate=1000.0, level=1.0, seed=0):

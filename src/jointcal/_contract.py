@@ -7,6 +7,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Literal, NoReturn
 
+from jointcal.units import FOOT_IN, G, G_SI, LBF_N
+
 __all__: list[str] = []
 
 Excitation = Literal["base", "force", "voltage"]
@@ -17,7 +19,7 @@ TIME, RESPONSE = "time_s", "response_accel_g"
 REFERENCE: dict[str, str] = {"base": "base_accel_g", "force": "force_lbf", "voltage": "drive_V"}
 LEVEL: dict[str, str] = {"base": "level_g", "force": "level_lbf", "voltage": "level_V"}  # manifest column
 # a response exported in m/s^2 under this name is converted to g (RESPONSE) on read
-RESPONSE_SI, G_SI = "response_accel_m_s2", 9.80665  # m/s^2 per g
+RESPONSE_SI = "response_accel_m_s2"
 TEXT = ("run_id", "assembly", "direction", "file")
 START = "sweep_start_s"  # optional manifest column: the sweep's start after the record's first sample (s)
 # optional manifest columns naming a lab format's channels: role -> column
@@ -27,9 +29,9 @@ POSITIVE = ("f_start_hz", "f_stop_hz", "sweep_rate_hz_per_s", "sample_rate_hz")
 QUANTITY: dict[str, str] = {"base": "acceleration", "force": "force", "voltage": "voltage"}
 # the size of each unit a lab file may use, in the contract's unit of its quantity (g, lbf, V, s)
 UNITS: dict[str, dict[str, float]] = {
-    "acceleration": {"g": 1.0, "m/s^2": 1.0 / G_SI, "in/s^2": 1.0 / 386.089, "ft/s^2": 1.0 / 32.174,
+    "acceleration": {"g": 1.0, "m/s^2": 1.0 / G_SI, "in/s^2": 1.0 / G, "ft/s^2": FOOT_IN / G,
                      "mm/s^2": 1e-3 / G_SI},
-    "force": {"lbf": 1.0, "N": 1.0 / 4.4482216, "kN": 1e3 / 4.4482216},
+    "force": {"lbf": 1.0, "N": 1.0 / LBF_N, "kN": 1e3 / LBF_N},
     "voltage": {"V": 1.0, "mV": 1e-3},
     "time": {"s": 1.0, "ms": 1e-3},
 }

@@ -56,7 +56,7 @@ from scipy import signal
 from scipy.ndimage import uniform_filter1d
 from scipy.optimize import brentq, least_squares
 
-from .models import G
+from .units import G
 
 __all__ = ["ModeFit", "h1_estimate", "zeta_at_quadrature", "displacement_ratio", "fit_mode", "pair_backbone",
            "backbone_at_peak", "record_frf", "frf_table"]

@@ -44,7 +44,7 @@ import pandas as pd
 
 from ._contract import LEVEL, REFERENCE, RESPONSE
 from .frf import backbone_at_peak, pair_backbone, record_frf, zeta_at_quadrature
-from .models import G
+from .units import G
 from .signal import envelopes
 from .sweepfit import baseband, fit_swept_mode
 

@@ -20,7 +20,7 @@ from scipy.signal.windows import hann
 
 from ._checks import clipped_mask
 from ._contract import REFERENCE, RESPONSE
-from .models import G
+from .units import G
 
 __all__ = ["EnvelopeMeta", "window_length", "track_drive", "envelopes", "meta_dict"]
 

@@ -67,7 +67,7 @@ from numpy.typing import NDArray
 from scipy import signal
 from scipy.optimize import least_squares
 
-from .models import G
+from .units import G
 
 __all__ = ["SweepFit", "baseband", "fit_swept_mode"]
 

@@ -32,7 +32,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _envelope_kernel as _k
-from .amplitude import G, _J
+from ..units import G
+from .amplitude import _J
 from .iwan import derived
 from .structure import MinistackModel
 

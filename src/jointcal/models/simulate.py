@@ -16,7 +16,7 @@ from scipy.linalg import expm
 from scipy.signal import resample_poly
 
 from . import _integrator
-from .amplitude import G
+from ..units import G
 from ._masing import kernel_constants
 from .iwan import derived
 from .structure import MinistackModel, state_space

@@ -58,7 +58,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _envelope_kernel as _k
-from .amplitude import G
+from ..units import G
 from .envelope import _NODES, _WEIGHTS, _amplitudes, _batch_shape, _field, _joint_terms
 from .structure import MinistackModel
 

@@ -18,7 +18,8 @@ import pandas as pd
 from dataclasses import fields, replace
 
 from ..io import write_csv_atomic, write_json_atomic, write_run
-from ..models import G, resonance_amplitude, simulate
+from ..models import resonance_amplitude, simulate
+from ..units import G
 from . import daq
 from .effects import effect_defaults, run_model
 from .shaker import Shaker, StructureMode, rig_truth, simulate_rig

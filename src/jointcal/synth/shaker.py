@@ -42,16 +42,17 @@ from dataclasses import dataclass, fields
 import numpy as np
 from numpy.typing import NDArray
 
-from ..models import G, MinistackModel, harmonic_balance
+from ..models import MinistackModel, harmonic_balance
 from ..models import _integrator
 from ..models._masing import kernel_constants
 from ..models.iwan import derived
+from ..units import G, INCH_M, LBF_N
 from ..models.simulate import _substep_maps, band_limited, fractional_delay, hermite_propagator
 
 __all__ = ["Shaker", "StructureMode", "BL_E_PER_BL", "peak_amplitude", "rig_matrices", "simulate_rig", "structure_equivalent", "rig_pole",
            "steady_amplitude", "structure_resonance_amplitude", "rig_truth"]
 
-BL_E_PER_BL = 4.448222 * 0.0254  # V/(in/s) of back-EMF per lbf/A of force constant (= 1 in SI)
+BL_E_PER_BL = LBF_N * INCH_M  # V/(in/s) of back-EMF per lbf/A of force constant (= 1 in SI)
 
 
 @dataclass(frozen=True)

@@ -34,7 +34,8 @@ from scipy.signal.windows import hann
 
 from .._contract import REFERENCE
 from ..modal import measure_run
-from ..models import G, MinistackModel, simulate
+from ..models import MinistackModel, simulate
+from ..units import G
 
 __all__ = ["clean_base", "reference_column", "drive_gain", "model_input", "simulate_record", "band_frames",
            "compare_run", "measure_pair", "time_envelopes", "draw_transmissibility"]
