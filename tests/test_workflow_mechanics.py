@@ -172,7 +172,7 @@ def test_editing_a_stage_module_reruns_that_stage_and_its_descendants_only(touch
 
 @pytest.mark.slow
 def test_discrepancy_target_runs_only_that_stage_and_what_it_needs(touched, tmp_path):
-    """Issue 9: `snakemake --cores 2 discrepancy` after an edit of the discrepancy code reruns that
+    """`snakemake --cores 2 discrepancy` after an edit of the discrepancy code reruns that
     stage alone; from an empty results folder it runs the stages it reads and none of the figure or
     report jobs of the others."""
     work, cfg = touched

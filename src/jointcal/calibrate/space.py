@@ -13,7 +13,7 @@ log scale gives each decade the same prior mass and GA resolution. beta below th
 is indistinguishable from 0: c = beta + (chi+1)/(chi+2) >= 0.048 for chi >= -0.95, so
 beta = 1e-4 changes c, phi_max, R and S by at most 0.2% (eqs. 3.5-3.7).
 
-The space grows by a named effect's parameters (`ParamSpace.grow`, issue 9): the
+The space grows by a named effect's parameters (`ParamSpace.grow`): the
 discrepancy workflow's candidate models are the six joint columns followed by the
 effect's own, each with its bounds and scaling, and the GA and the sampler work on the
 grown unit cube unchanged.

@@ -20,6 +20,7 @@ import numpy as np
 import pandas as pd
 
 from ..calibrate.space import LOG_SCALED, PARAMS, UNITS
+from ..io import level_column
 
 __all__ = ["rst_escape", "ga_best_point", "bound_hits", "chain_status", "table_3_2_html", "summary_html", "landing_html",
            "fmt"]
@@ -256,10 +257,10 @@ def summary_html(*, campaign: str, runs: pd.DataFrame, modal: pd.DataFrame, stat
            "<p><b>Table 3.2</b> (the paper's calibrated parameters, in its layout)</p>", table_html,
            "<h3>Details</h3>"]
     n_asm = runs["assembly"].nunique() if "assembly" in runs else 0
-    level = "level_g" if "level_g" in runs.columns else ("level_lbf" if "level_lbf" in runs.columns else None)
+    level = level_column(runs.columns)
     levels = "" if level is None else ", levels " + ", ".join(f"{v:g}" for v in sorted(runs[level].dropna().unique()))
     out.append(f"<p><b>Campaign</b> <code>{html.escape(campaign)}</code>: {len(runs)} runs on {n_asm} assemblies"
-               f"{html.escape(levels)}{' g' if level == 'level_g' else (' lbf' if level else '')}.</p>")
+               f"{html.escape(levels)}{' ' + level.split('_', 1)[1] if level else ''}.</p>")
     flag_rows = []
     for label, t in (("ingest (runs.csv)", runs), ("modal (modal_properties.csv)", modal)):
         n, detail = _flag_counts(t)

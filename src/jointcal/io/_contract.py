@@ -1,10 +1,11 @@
-"""The raw-data contract's names and errors, shared by `jointcal.io` and its helpers.
+"""The raw-data contract's names and errors, and the one rule that tells a run's excitation.
 
-Private: `jointcal.io` re-exports `CampaignError` and `CampaignWarning`.
+Private: `jointcal.io` re-exports `CampaignError`, `CampaignWarning`, `excitation_kind`
+and `level_column`.
 """
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from typing import Literal, NoReturn
 
 from jointcal.units import FOOT_IN, G, G_SI, LBF_N
@@ -54,6 +55,36 @@ for _cls in (CampaignError, CampaignWarning):
 def fail(where: object, problem: str, fix: str) -> NoReturn:
     """Raise `CampaignError` with the sentence ``"<where>: <problem>; <fix>."``."""
     raise CampaignError(f"{where}: {problem}; {fix}.")
+
+
+def excitation_kind(names: Iterable[object], default: Excitation | None = "base") -> Excitation | None:
+    """The excitation a set of names shows: 'base', 'force' or 'voltage'.
+
+    The one place that decides it: a record's reference column (``base_accel_g``,
+    ``force_lbf``, ``drive_V``) first, else a level column (``level_g``, ``level_lbf``,
+    ``level_V``, as a manifest row, runs.csv, modal_properties.csv or a metrics table carry
+    it), each looked for in that order.
+
+    Parameters
+    ----------
+    names : iterable
+        Column names of a record or table, or the keys of a row (a mapping iterates its keys).
+    default : {'base', 'force', 'voltage'} or None, optional
+        The answer when no name is a reference or level column.
+
+    Returns
+    -------
+    str or None
+    """
+    names = {str(n) for n in names}
+    return next((k for k, c in REFERENCE.items() if c in names), None) or \
+        next((k for k, c in LEVEL.items() if c in names), default)
+
+
+def level_column(names: Iterable[object]) -> str | None:
+    """The level column among `names` (``level_g``, ``level_lbf`` or ``level_V``, in that order); None if none."""
+    names = {str(n) for n in names}
+    return next((c for c in LEVEL.values() if c in names), None)
 
 
 def excitation_of(names: Sequence[str], where: object, *, expected: Excitation | None = None,
