@@ -70,6 +70,8 @@ def half_power(f: NDArray[np.float64], a: NDArray[np.float64], ip: int) -> tuple
     i, j = half_power_lines(a, ip)
     lo = np.nan if i is None else f[i] + (level - a[i]) * (f[i + 1] - f[i]) / (a[i + 1] - a[i])
     hi = np.nan if j is None else f[j - 1] + (level - a[j - 1]) * (f[j] - f[j - 1]) / (a[j] - a[j - 1])
+    if not np.isfinite(lo + hi):  # one side missing: no bandwidth (min/max would pass the found side twice)
+        return np.nan, np.nan
     return min(lo, hi), max(lo, hi)
 
 
