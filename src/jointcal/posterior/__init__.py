@@ -1,8 +1,8 @@
 """Posterior stage: emcee around the GA optimum, credible intervals and what the data constrain.
 
 Modules: `coords` (sampler coordinates aligned with the identifiable combinations),
-`likelihood` (vectorised log-posterior), `sampler` (emcee in chunks to 50 tau,
-resumable, with an early stop when 50 tau is out of reach), `modes` (separated modes of the
+`likelihood` (vectorised log-posterior), `sampler` (emcee in chunks to tau_factor x tau,
+resumable, with an early stop when that is out of reach), `modes` (separated modes of the
 draws), `summary` (tables, sentences, predictive band), `settings` (the
 ``posterior:`` config section) and `stage` (files).
 """

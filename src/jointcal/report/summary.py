@@ -101,7 +101,7 @@ def chain_status(z: Mapping, *, tau_factor: float = 50.0) -> tuple[bool, str]:
     if converged:
         return True, f"converged: {n:.0f} steps = {multiple:.1f} tau (tau {tau:.0f} steps)"
     why = {"max_steps": "stopped at the step cap",
-           "projected": ("stopped early: 50 tau projected to need "
+           "projected": (f"stopped early: {tau_factor:g} tau projected to need "
                          + (f"{float(z['projected_steps']):.0f} steps" if np.isfinite(float(z.get(
                              "projected_steps", np.inf))) else "more steps than any cap (tau grows with the chain)"))}
     return False, (f"NOT converged: {multiple:.1f} tau of the {tau_factor:g} required ({n:.0f} steps, tau {tau:.0f}); "
