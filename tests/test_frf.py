@@ -5,9 +5,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from jointcal.measure import h1_estimate, record_frf, zeta_at_quadrature
 from jointcal.io import CampaignError, read_run, write_run
-from jointcal.measure import measure_run
+from jointcal.measure import h1_estimate, measure_run, record_frf, zeta_at_quadrature
 from jointcal.models import G, MinistackModel, simulate
 from jointcal.synth.daq import controlled_sweep
 

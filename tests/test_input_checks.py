@@ -15,10 +15,10 @@ import pytest
 from _campaign import REPO, edit_manifest, edit_run, workflow_copy
 from scipy import signal
 
-from jointcal.io._clipping import clip_levels, clipped_mask
 from jointcal.calibrate.data import select_modal
 from jointcal.cli import main
 from jointcal.io import CampaignError, CampaignWarning, ingest_campaign, listed_record, read_run, validate_run
+from jointcal.io._clipping import clip_levels, clipped_mask
 from jointcal.units import G_SI  # m/s^2 per g
 
 

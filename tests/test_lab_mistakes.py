@@ -21,10 +21,10 @@ import pytest
 import scipy.io
 from _campaign import REPO, edit_manifest, edit_run, example_copy, workflow_copy
 
-from jointcal.io._amplitudes import low_frequency_ratio
-from jointcal.io._time import check_time, time_resolution
 from jointcal.cli import main
 from jointcal.io import CampaignError, CampaignWarning, ingest_campaign, read_manifest, read_run, validate_run
+from jointcal.io._amplitudes import low_frequency_ratio
+from jointcal.io._time import check_time, time_resolution
 from jointcal.units import G_SI  # m/s^2 per g
 
 RUN, OTHER = "first_01_1g_up", "first_07_2g_up"  # a 1 g up sweep and a 2 g one, from raw_data/

@@ -10,9 +10,8 @@ import json
 import numpy as np
 import pytest
 
-from jointcal.measure import record_frf
 from jointcal.io import ingest_campaign, read_manifest, read_run
-from jointcal.measure import measure_run
+from jointcal.measure import measure_run, record_frf
 from jointcal.models import G, IwanParams, MinistackModel
 from jointcal.synth import generate, load_spec
 from jointcal.synth.daq import controlled_sweep

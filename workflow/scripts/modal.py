@@ -12,10 +12,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from jointcal.io import UNUSABLE_FLAGS
-from jointcal.measure import frf_table
-from jointcal.io import listed_record, read_run, write_csv_atomic
-from jointcal.measure import ENVELOPE_COLUMNS, FLAG_WORDS, modal_properties, scatter
+from jointcal.io import UNUSABLE_FLAGS, listed_record, read_run, write_csv_atomic
+from jointcal.measure import ENVELOPE_COLUMNS, FLAG_WORDS, frf_table, modal_properties, scatter
 
 
 def main(smk) -> None:
