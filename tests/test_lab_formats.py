@@ -15,7 +15,7 @@ from _campaign import edit_manifest, example_copy
 from nptdms import ChannelObject, GroupObject, TdmsWriter
 
 from jointcal.io import CampaignError, ingest_campaign, read_manifest, read_run
-from jointcal.measure import measure_run
+from jointcal.measure.modal import measure_run
 from jointcal.units import G_SI  # m/s^2 per g
 
 EXAMPLE_RUN = "first_01_1g_up"

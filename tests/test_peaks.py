@@ -1,10 +1,10 @@
-"""The shared read-outs of jointcal.measure._peaks and the one excitation rule of jointcal.io, against closed forms."""
+"""The shared read-outs of jointcal.measure.peaks and the one excitation rule of jointcal.io, against closed forms."""
 import numpy as np
 import pandas as pd
 import pytest
 
 from jointcal.io import excitation_kind, level_column
-from jointcal.measure._peaks import (
+from jointcal.measure.peaks import (
     anchored_phase, full_drive, half_power, half_power_lines, parabola_vertex, phase_crossing, transmissibility,
 )
 

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from jointcal.io import ingest_campaign, read_manifest, read_run
-from jointcal.measure import measure_run, record_frf
+from jointcal.measure.frf import record_frf
+from jointcal.measure.modal import measure_run
 from jointcal.models import G, IwanParams, MinistackModel
 from jointcal.synth import generate, load_spec
 from jointcal.synth.daq import controlled_sweep

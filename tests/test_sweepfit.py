@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from jointcal.measure import fit_swept_mode
+from jointcal.measure.sweepfit import fit_swept_mode
 from jointcal.models import G, IwanParams, MinistackModel, harmonic_balance, simulate
 from jointcal.synth.daq import controlled_sweep
 

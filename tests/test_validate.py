@@ -17,7 +17,7 @@ from _modal_helpers import modal_table
 
 from jointcal.calibrate import CalibrateSettings, run_calibration
 from jointcal.io import read_manifest, read_run, write_csv_atomic
-from jointcal.measure import measure_run
+from jointcal.measure.modal import measure_run
 from jointcal.models import MinistackModel, simulate
 from jointcal.units import G
 from jointcal.synth import generate

@@ -42,7 +42,8 @@ from jointcal.calibrate import CalibrateSettings, read_modal, run_calibration  #
 from jointcal.design import DesignSettings, run_design  # noqa: E402
 from jointcal.design.narrowing import DEPTHS, depth_labels  # noqa: E402
 from jointcal.io import read_manifest, read_run, write_csv_atomic  # noqa: E402
-from jointcal.measure import measure_run, scatter  # noqa: E402
+from jointcal.measure.modal import measure_run  # noqa: E402
+from jointcal.measure.scatter import scatter  # noqa: E402
 from jointcal.posterior import PosteriorSettings, run_posterior  # noqa: E402
 from jointcal.posterior.identified import identified_table, quantities  # noqa: E402
 

@@ -24,7 +24,7 @@ from test_input_checks import _adc, _longest_flat_top, _row, _sdof_sweep  # noqa
 from jointcal.io import ingest_campaign, read_manifest, read_run  # noqa: E402
 from jointcal.io._amplitudes import window_amplitudes
 from jointcal.io._clipping import clip_levels  # noqa: E402
-from jointcal.measure import measure_run  # noqa: E402
+from jointcal.measure.modal import measure_run  # noqa: E402
 
 ZETA = 0.02
 

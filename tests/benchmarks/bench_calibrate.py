@@ -77,8 +77,8 @@ def bench_sweep_objective(d, t_batch, t_near):
     then the modal stage's own read-out of f_res and zeta from it (jointcal.measure.envelopes + jointcal.measure.modal)."""
     import pandas as pd
 
-    from jointcal.measure import modal_properties
-    from jointcal.measure import envelopes, meta_dict
+    from jointcal.measure.modal import modal_properties
+    from jointcal.measure.envelopes import envelopes, meta_dict
 
     p = TABLE_3_2["first"]
     iwan = IwanParams(p["Fs"], p["KT"], p["chi"], p["beta"])

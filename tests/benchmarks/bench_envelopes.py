@@ -15,7 +15,7 @@ from scipy.signal import ShortTimeFFT
 from scipy.signal.windows import hann
 
 from jointcal.io import read_manifest, read_run
-from jointcal.measure import envelopes, window_length
+from jointcal.measure.envelopes import envelopes, window_length
 
 REPO = Path(__file__).resolve().parents[2]
 

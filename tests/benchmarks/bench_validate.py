@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from jointcal.io import read_manifest, read_run
-from jointcal.measure import measure_run
+from jointcal.measure.modal import measure_run
 from jointcal.models import simulate
 from jointcal.validate import ValidateSettings, model_from_best, model_from_params, models_from_samples, validate_runs
 from jointcal.validate.runs import clean_base

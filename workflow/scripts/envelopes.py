@@ -10,7 +10,7 @@ from pathlib import Path
 import pandas as pd
 
 from jointcal.io import read_run, write_csv_atomic, write_json_atomic
-from jointcal.measure import ENVELOPE_COLUMNS, envelopes, meta_dict
+from jointcal.measure.envelopes import ENVELOPE_COLUMNS, envelopes, meta_dict
 
 
 def main(smk) -> None:

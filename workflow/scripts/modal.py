@@ -13,7 +13,10 @@ from pathlib import Path
 import pandas as pd
 
 from jointcal.io import UNUSABLE_FLAGS, listed_record, read_run, write_csv_atomic
-from jointcal.measure import ENVELOPE_COLUMNS, FLAG_WORDS, frf_table, modal_properties, scatter
+from jointcal.measure.envelopes import ENVELOPE_COLUMNS
+from jointcal.measure.frf import frf_table
+from jointcal.measure.modal import FLAG_WORDS, modal_properties
+from jointcal.measure.scatter import scatter
 
 
 def main(smk) -> None:

@@ -4,7 +4,7 @@ from pathlib import Path
 import pandas as pd
 
 from jointcal.io import level_column, listed_record, read_run
-from jointcal.measure import window_length
+from jointcal.measure.envelopes import window_length
 from jointcal.report.modal import plot_envelopes, plot_frequency_damping, plot_spectrogram
 
 

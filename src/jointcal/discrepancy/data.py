@@ -19,7 +19,8 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from ..models import SweepDrive
-from ..measure import full_drive, transmissibility, window_length
+from ..measure.envelopes import window_length
+from ..measure.peaks import full_drive, transmissibility
 from ..validate.error import BINS
 
 __all__ = ["RunEnvelope", "run_envelope", "run_zeta", "scale_arrays"]

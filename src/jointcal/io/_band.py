@@ -8,7 +8,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from jointcal.io._contract import MIN_CYCLES, fail
-from jointcal.measure._peaks import parabola_vertex
+from jointcal.measure.peaks import parabola_vertex
 
 __all__ = ["peak_frequency", "drive_band", "check_head"]
 

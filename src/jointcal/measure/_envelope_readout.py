@@ -13,7 +13,7 @@ from numpy.typing import NDArray
 
 from ..io._contract import REFERENCE
 from ..units import G
-from ._peaks import anchored_phase, envelope, full_drive, half_power, parabola_vertex, phase_crossing, transmissibility
+from .peaks import anchored_phase, envelope, full_drive, half_power, parabola_vertex, phase_crossing, transmissibility
 
 __all__ = ["envelope_estimates"]
 

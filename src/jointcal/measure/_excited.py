@@ -12,7 +12,7 @@ import pandas as pd
 from ..io._contract import REFERENCE, RESPONSE
 from ..units import G
 from .backbone import backbone_at_peak, pair_backbone
-from ._peaks import envelope
+from .peaks import envelope
 from .frf import frf_flags, quadrature_ok, zeta_at_quadrature
 from .sweepfit import baseband, fit_swept_mode
 

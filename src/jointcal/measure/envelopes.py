@@ -21,9 +21,12 @@ from scipy.signal.windows import hann
 from ..io._clipping import clipped_mask
 from ..io._contract import REFERENCE, RESPONSE, excitation_kind
 from ..units import G
-from ._peaks import parabola_vertex
+from .peaks import parabola_vertex
 
-__all__ = ["EnvelopeMeta", "window_length", "track_drive", "envelopes", "meta_dict"]
+__all__ = ["EnvelopeMeta", "window_length", "track_drive", "envelopes", "meta_dict", "ENVELOPE_COLUMNS"]
+
+ENVELOPE_COLUMNS = ("time_s", "f_drive_hz", "ref_re", "ref_im", "resp_re", "resp_im", "z_re", "z_im", "h2_amp_g",
+                    "h3_amp_g", "noise_g", "drive_on", "bad")  # one row per frame
 
 
 @dataclass(frozen=True)

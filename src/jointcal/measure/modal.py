@@ -37,13 +37,11 @@ from ..io._contract import LEVEL, REFERENCE, RESPONSE, excitation_kind
 from ..units import G
 from ._envelope_readout import EDGE, envelope_estimates
 from ._excited import REFIT, SWEEP_FRAME, ZETA_MAX, backbone_estimate, excited_readout, modal_constant, sweep_estimate
-from .envelopes import envelopes
+from .envelopes import ENVELOPE_COLUMNS, envelopes
 from .frf import ModeFit, frf_flags, quadrature_ok, record_frf, zeta_at_quadrature
 
 __all__ = ["modal_properties", "measure_run", "readout_rule", "FLAG_WORDS", "ENVELOPE_COLUMNS"]
 
-ENVELOPE_COLUMNS = ("time_s", "f_drive_hz", "ref_re", "ref_im", "resp_re", "resp_im", "z_re", "z_im", "h2_amp_g",
-                    "h3_amp_g", "noise_g", "drive_on", "bad")
 
 FLAG_WORDS = {
     "eta_high": "sweep too fast for quasi-steady envelopes (eta > eta_max)",

@@ -14,7 +14,7 @@ from numpy.typing import NDArray
 from scipy import signal
 from scipy.optimize import least_squares
 
-from ._peaks import anchored_phase, half_power_lines, phase_crossing
+from .peaks import anchored_phase, half_power_lines, phase_crossing
 
 __all__ = ["ModeFit", "fit_mode", "zeta_at_quadrature", "quadrature_ok", "frf_flags", "basis", "project"]
 
