@@ -34,8 +34,7 @@ from scipy.signal.windows import hann
 
 from ..io._contract import LEVEL, REFERENCE, excitation_kind, level_column
 from ..measure.modal import measure_run
-from ..measure.peaks import transmissibility
-from ..measure.peaks import FULL_DRIVE
+from ..measure.peaks import FULL_DRIVE, transmissibility
 from ..measure.peaks import full_drive as full_drive_frames
 from ..models import MinistackModel, simulate
 from ..units import G
