@@ -5,6 +5,8 @@ of whole-ish cycles; the quadrature crossing of z against the base acceleration.
 """
 import numpy as np
 
+from jointcal.units import G
+
 
 def demodulate(x, phase, nwin):
     e = np.exp(-1j * phase)
@@ -35,8 +37,6 @@ def linear_sweep(fa, fb, rate, fs, level):
     phase = 2 * np.pi * (fa * t + 0.5 * sgn * rate * t**2)
     return t, phase, fa + sgn * rate * t, level * np.sin(phase)
 
-
-G = 386.089
 
 
 def nominal_phase(df, row):

@@ -6,7 +6,8 @@ import numpy as np
 import pandas as pd
 
 from jointcal.io import read_manifest, read_run
-from jointcal.modal import measure_run, scatter
+from jointcal.measure.modal import measure_run
+from jointcal.measure.scatter import scatter
 from jointcal.models import harmonic_balance
 
 

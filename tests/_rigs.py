@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 
 from jointcal.io import read_manifest, read_run
-from jointcal.modal import measure_run
+from jointcal.measure.modal import measure_run
 from jointcal.models import G
 from jointcal.synth import generate
 from jointcal.synth.campaign import _model

@@ -86,7 +86,7 @@ def test_vectorised_over_population_and_amplitudes():
 
 @pytest.mark.parametrize("level", [1.0, 2.0, 5.0, 10.0])
 def test_qsma_offset_from_harmonic_balance_table_3_2(level):
-    """QSMA's secant frequency sits above the first-harmonic one (PHYSICS.md: ~0.15% at 1 g, ~0.35% at 10 g)."""
+    """QSMA's secant frequency sits above the first-harmonic one (docs/physics.md, section 2: ~0.15% at 1 g, ~0.35% at 10 g)."""
     q, f, z = resonance_amplitude(level, **FIRST)
     assert 2 * (2 * np.pi * f) ** 2 * z * q == pytest.approx(level * G, rel=1e-9)  # energy balance
     fq, zq = qsma(q, **FIRST)

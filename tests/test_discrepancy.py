@@ -292,7 +292,8 @@ def test_end_to_end_hidden_gain_is_named_and_the_gap_shrinks(tmp_path):
     reading 12% high: named, E falls by more than 70% in the time-domain revalidation."""
     sys.path.insert(0, str(Path(__file__).parent))
     from jointcal.io import read_manifest, read_run, write_csv_atomic
-    from jointcal.modal import measure_run, scatter
+    from jointcal.measure.modal import measure_run
+    from jointcal.measure.scatter import scatter
     from jointcal.synth import generate
 
     spec = {"seed": 11, "sample_rate_hz": 10000.0,

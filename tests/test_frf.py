@@ -1,13 +1,13 @@
-"""Whole-record FRF (jointcal.frf): H1 against analytic FRFs, the single-mode fit, units on read."""
+"""Whole-record FRF (jointcal.measure.frf): H1 against analytic FRFs, the single-mode fit, units on read."""
 from __future__ import annotations
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from jointcal.frf import h1_estimate, record_frf, zeta_at_quadrature
 from jointcal.io import CampaignError, read_run, write_run
-from jointcal.modal import measure_run
+from jointcal.measure.frf import h1_estimate, record_frf, zeta_at_quadrature
+from jointcal.measure.modal import measure_run
 from jointcal.models import G, MinistackModel, simulate
 from jointcal.synth.daq import controlled_sweep
 
@@ -140,7 +140,7 @@ def test_voltage_record_round_trip(tmp_path):
 def test_pair_backbone_of_a_linear_frf_is_its_pole():
     """Equal-amplitude pairs of A e^{i theta} / (W^2 - w^2 + 2 i zeta W w): every level gives the pole,
     whatever the (unknown) phase of the modal constant and with a residual term beside it."""
-    from jointcal.frf import backbone_at_peak, pair_backbone
+    from jointcal.measure.backbone import backbone_at_peak, pair_backbone
 
     f = np.linspace(80.0, 120.0, 8001)
     w, W = 2 * np.pi * f, 2 * np.pi * F0
@@ -161,8 +161,9 @@ def test_pair_backbone_reads_a_bent_voltage_peak_at_its_amplitude():
     at its own amplitude (first-harmonic balance of the joint, solved line by line): the pairs give the
     rig's equivalent-linear pole at each level's amplitude, and at the peak the pole at the peak's
     amplitude (the truth `rig_pole`, an independent root of the coupled rig's polynomial). The single-mode
-    rational fit of the same bent peak is off by more than the 0.2% the issue allows."""
-    from jointcal.frf import backbone_at_peak, fit_mode, pair_backbone
+    rational fit of the same bent peak is off by more than the 0.2% a read-out must hold."""
+    from jointcal.measure.backbone import backbone_at_peak, pair_backbone
+    from jointcal.measure.frf import fit_mode
     from jointcal.models import IwanParams
     from jointcal.synth.rig_truth import _x_over_v, rig_pole
     from jointcal.synth.shaker import Shaker

@@ -15,12 +15,12 @@ import pytest
 from _campaign import REPO, edit_manifest, edit_run, workflow_copy
 from scipy import signal
 
-from jointcal._checks import clip_levels, clipped_mask
 from jointcal.calibrate.data import select_modal
 from jointcal.cli import main
 from jointcal.io import CampaignError, CampaignWarning, ingest_campaign, listed_record, read_run, validate_run
+from jointcal.io._clipping import clip_levels, clipped_mask
+from jointcal.units import G_SI  # m/s^2 per g
 
-G_SI = 9.80665  # m/s^2 per g
 
 
 def _one_sentence(msg: str, *words: str) -> None:
@@ -372,7 +372,7 @@ def test_workflow_keeps_a_units_mistake_out_of_the_modal_fit(tmp_path, campaign)
 def test_clipped_runs_stay_out_of_the_fit_because_leaving_frames_out_does_not_save_the_damping():
     """Why `clipped` is in UNUSABLE_FLAGS: with the clipped frames left out, the resonance peak is
     missing and the damping of a linear SDOF (zeta 0.02) clipped at 60 % of its peak comes out far high."""
-    from jointcal.modal import measure_run
+    from jointcal.measure.modal import measure_run
 
     t, base, resp, peak = _sdof_sweep(12800.0)
     zeta = {}

@@ -13,7 +13,8 @@ import pytest
 import scipy.io
 from _campaign import DATA, edit_manifest, edit_run
 
-from jointcal._checks import clip_levels, peak_frequency
+from jointcal.io._band import peak_frequency
+from jointcal.io._clipping import clip_levels
 from jointcal.io import (
     CampaignError, CampaignWarning, ingest_campaign, read_manifest, read_run, validate_run,
     write_bytes_atomic, write_csv_atomic, write_json_atomic, write_run,
@@ -302,7 +303,7 @@ def test_csv_writer_failing_midway_keeps_old_file(tmp_path, monkeypatch):
 
 
 def test_clipped_mask_marks_exactly_the_clipped_samples():
-    from jointcal._checks import clipped_mask
+    from jointcal.io._clipping import clipped_mask
 
     x = np.sin(np.linspace(0, 20 * np.pi, 2000)) * 1.3
     y = np.clip(x, -1.0, 1.1)  # asymmetric limits

@@ -98,8 +98,8 @@ def test_masing_loop_closure_erases_memory():
 def test_uniform_100_sliders_misstate_low_amplitude_dissipation():
     """The reason for exact Iwan: tmdsimpy-style sliders overstate D at 1% of phi_max.
 
-    Measured here: +24% with 100 midpoint sliders (PHYSICS.md reports +33% for
-    tmdsimpy's own implementation); the exact turning-point force has no such error.
+    Measured here: +24% with 100 midpoint sliders (docs/physics.md, section 1: about a quarter
+    to a third, depending on the slider scheme); the exact turning-point force has no such error.
     """
     p = TABLE_3_2[0]
     phi_max = float(derived(p.Fs, p.KT, p.chi, p.beta)[0])

@@ -1,4 +1,4 @@
-"""A lab's own exports (jointcal._lab_formats through jointcal.io.read_run): UFF 58 written by pyuff,
+"""A lab's own exports (jointcal.io._lab_formats through jointcal.io.read_run): UFF 58 written by pyuff,
 TDMS written by npTDMS and a Test.Lab-style MATLAB struct read as the same record as the contract's CSV,
 channels named by the manifest, units taken from the file and checked against the channel's role."""
 from __future__ import annotations
@@ -15,9 +15,9 @@ from _campaign import edit_manifest, example_copy
 from nptdms import ChannelObject, GroupObject, TdmsWriter
 
 from jointcal.io import CampaignError, ingest_campaign, read_manifest, read_run
-from jointcal.modal import measure_run
+from jointcal.measure.modal import measure_run
+from jointcal.units import G_SI  # m/s^2 per g
 
-G_SI = 9.80665  # m/s^2 per g
 EXAMPLE_RUN = "first_01_1g_up"
 NAMES = {"base_accel_g": "Ctrl Z", "drive_V": "Amp out", "response_accel_g": "Slug Z"}
 QUANTITY = {"base_accel_g": "Acceleration", "drive_V": "Voltage", "response_accel_g": "Acceleration"}

@@ -21,12 +21,12 @@ import pytest
 import scipy.io
 from _campaign import REPO, edit_manifest, edit_run, example_copy, workflow_copy
 
-from jointcal._amplitudes import low_frequency_ratio
-from jointcal._checks import _check_time, time_resolution
 from jointcal.cli import main
 from jointcal.io import CampaignError, CampaignWarning, ingest_campaign, read_manifest, read_run, validate_run
+from jointcal.io._amplitudes import low_frequency_ratio
+from jointcal.io._time import check_time, time_resolution
+from jointcal.units import G_SI  # m/s^2 per g
 
-G_SI = 9.80665  # m/s^2 per g
 RUN, OTHER = "first_01_1g_up", "first_07_2g_up"  # a 1 g up sweep and a 2 g one, from raw_data/
 FILE = f"runs/{RUN}.csv.gz"
 
@@ -339,7 +339,7 @@ def test_rounded_times_are_not_jitter(fmt, bound):
     t = np.arange(int(60 * 12800)) / 12800.0
     t = t.astype(np.float32).astype(float) if fmt == "float32" else np.array([float(fmt % v) for v in t])
     assert time_resolution(t).max() == pytest.approx(bound, rel=0.01)
-    assert _check_time(t, 12800.0, "r.csv", "'r'") == pytest.approx(12800.0, rel=1e-6)
+    assert check_time(t, 12800.0, "r.csv", "'r'") == pytest.approx(12800.0, rel=1e-6)
 
 
 def _with_head(seconds: float):

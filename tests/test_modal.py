@@ -7,9 +7,10 @@ import pytest
 
 from _modal_helpers import against_truth, modal_table
 from jointcal.io import write_run
-from jointcal.modal import modal_properties, scatter
+from jointcal.measure.envelopes import envelopes
+from jointcal.measure.modal import modal_properties
+from jointcal.measure.scatter import scatter
 from jointcal.models import G, IwanParams, MinistackModel, harmonic_balance, simulate
-from jointcal.signal import envelopes
 from jointcal.synth import generate
 from jointcal.synth.daq import controlled_sweep
 

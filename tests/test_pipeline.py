@@ -17,7 +17,7 @@ import pytest
 from _modal_helpers import modal_table
 from jointcal.calibrate import CalibrateSettings, run_calibration
 from jointcal.io import write_csv_atomic
-from jointcal.modal import scatter
+from jointcal.measure.scatter import scatter
 from jointcal.models import harmonic_balance
 from jointcal.synth import generate
 

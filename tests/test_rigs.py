@@ -10,9 +10,9 @@ import json
 import numpy as np
 import pytest
 
-from jointcal.frf import record_frf
 from jointcal.io import ingest_campaign, read_manifest, read_run
-from jointcal.modal import measure_run
+from jointcal.measure.frf import record_frf
+from jointcal.measure.modal import measure_run
 from jointcal.models import G, IwanParams, MinistackModel
 from jointcal.synth import generate, load_spec
 from jointcal.synth.daq import controlled_sweep

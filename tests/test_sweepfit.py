@@ -1,12 +1,12 @@
-"""Swept-mode fit (jointcal.sweepfit): a fast chirp's whole transient against closed forms and the
+"""Swept-mode fit (jointcal.measure.sweepfit): a fast chirp's whole transient against closed forms and the
 harmonic balance of the exact Iwan joint."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
+from jointcal.measure.sweepfit import fit_swept_mode
 from jointcal.models import G, IwanParams, MinistackModel, harmonic_balance, simulate
-from jointcal.sweepfit import fit_swept_mode
 from jointcal.synth.daq import controlled_sweep
 
 

@@ -200,7 +200,7 @@ def test_contact_spring_acts_beyond_its_gap_with_even_harmonics(effect_lab):
     """contact_spring (gap 8e-5 in): at 1 g the slug (q ~ 5e-5 in) never reaches the stop, so the run is
     the base run; at 10 g (q ~ 2.9e-4 in) the stop stiffens the resonance and the asymmetric force puts
     a 2nd harmonic in the response that dominates the 3rd (the joint's own harmonics are odd)."""
-    from jointcal.modal import measure_run
+    from jointcal.measure.modal import measure_run
     base, eff = effect_lab("none"), effect_lab("contact_spring")
 
     def props(camp, suffix):

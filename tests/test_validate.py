@@ -17,8 +17,9 @@ from _modal_helpers import modal_table
 
 from jointcal.calibrate import CalibrateSettings, run_calibration
 from jointcal.io import read_manifest, read_run, write_csv_atomic
-from jointcal.modal import measure_run
+from jointcal.measure.modal import measure_run
 from jointcal.models import MinistackModel, simulate
+from jointcal.units import G
 from jointcal.synth import generate
 from jointcal.synth.hidden import run_model
 from jointcal.validate import (
@@ -27,7 +28,7 @@ from jointcal.validate import (
 )
 
 TRUTH = {"Fs": 313.0, "KT": 1.02e6, "chi": -0.65, "beta": 0.004, "k": 6.12e5, "zeta_v": 0.0015}
-M = 2.65 / 386.089
+M = 2.65 / G
 
 
 def _sweep_record(fs=12800.0, f0=1500.0, f1=3000.0, rate=1000.0, level=1.0, seed=0):
@@ -57,7 +58,7 @@ def test_linear_model_envelope_matches_the_analytic_frf():
     """A linear model through simulate + measure_run equals H = (k + i w c)/(k - m w^2 + i w c).
 
     A sweep at rate r shows the steady state delayed by the group delay tau_g = -dphi/domega
-    (PHYSICS.md), so the envelope at drive frequency f is H(f - r tau_g(f)) to first order in
+    (docs/physics.md, section 6), so the envelope at drive frequency f is H(f - r tau_g(f)) to first order in
     eta = r/(f zeta)^2 (0.1 here); the second-order remainder measured 0.05 dB at the peak,
     0.25 deg. Sampled at 25.6 kHz: at 12.8 kHz the simulator's cubic-Hermite reading of the
     sampled input attenuates it by 0.1 dB at 2.7 kHz (4.7 samples per cycle), 30x less here.
@@ -127,7 +128,7 @@ def _campaign(tmp: Path, effect: dict, measurement: dict | None = None) -> tuple
 
 @pytest.mark.slow
 def test_E_of_the_calibrated_model_is_at_the_noise_floor_and_grows_with_a_hidden_effect(tmp_path):
-    """Issue 8: E(calibrated) <= 1.5 E(true model) without an effect; >= 3x with sensor_gain 1.15.
+    """E(calibrated) <= 1.5 E(true model) without an effect; >= 3x with sensor_gain 1.15.
 
     One assembly, 1 g x2 repeats up/down, 5 g and 10 g, band 1600-2600 Hz (CI time). The true
     model's E is the noise floor only where noise sets the scale: the campaigns carry 2% sensor

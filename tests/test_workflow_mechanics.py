@@ -38,9 +38,10 @@ def _names(files: list[Path]) -> set[str]:
 def test_stage_sources_follow_imports_through_the_package():
     assert stage_sources(SCRIPTS / "modal.py")[0] == SCRIPTS / "modal.py"  # the script's own text counts too
     modal = _names(stage_sources(SCRIPTS / "modal.py"))
-    assert {"modal.py", "signal.py", "io.py", "_checks.py", "__init__.py"} <= modal
+    assert {"measure/modal.py", "measure/envelopes.py", "io/__init__.py", "io/_checks.py", "__init__.py"} <= modal
     assert not any(n.startswith(("calibrate/", "posterior/", "report/")) for n in modal)
-    assert "modal.py" not in _names(stage_sources(SCRIPTS / "ingest.py"))
+    assert "measure/modal.py" not in _names(stage_sources(SCRIPTS / "ingest.py"))
+    assert "measure/modal.py" not in _names(stage_sources(SCRIPTS / "envelopes.py"))
     # `from ..calibrate.space import ...` in report/calibration.py, and the packages' __init__ files
     figures = _names(stage_sources(SCRIPTS / "calibration_figures.py"))
     assert {"report/__init__.py", "report/calibration.py", "calibrate/__init__.py", "calibrate/space.py"} <= figures
@@ -157,7 +158,7 @@ def test_editing_a_stage_module_reruns_that_stage_and_its_descendants_only(touch
     work, cfg = touched
     pkg = work / "src" / "jointcal"
     cases = [
-        ("modal.py", DOWNSTREAM_OF_MODAL),  # not ingest, not envelopes
+        ("measure/modal.py", DOWNSTREAM_OF_MODAL),  # not ingest, not envelopes
         ("report/calibration.py", {"calibration_figures", "posterior_corner", "posterior_report", "report_summary",
                                     "validate_figures", "design_assembly"}),  # figures and report pages only
         ("design/narrowing.py", {"design_assembly", "report_summary"}),  # the design and the verdict that reads it
@@ -172,7 +173,7 @@ def test_editing_a_stage_module_reruns_that_stage_and_its_descendants_only(touch
 
 @pytest.mark.slow
 def test_discrepancy_target_runs_only_that_stage_and_what_it_needs(touched, tmp_path):
-    """Issue 9: `snakemake --cores 2 discrepancy` after an edit of the discrepancy code reruns that
+    """`snakemake --cores 2 discrepancy` after an edit of the discrepancy code reruns that
     stage alone; from an empty results folder it runs the stages it reads and none of the figure or
     report jobs of the others."""
     work, cfg = touched
@@ -237,7 +238,7 @@ def test_failed_rerun_removes_the_downstream_outputs_it_could_not_remake(touched
                   results / "posterior" / "table_3_2.csv", results / "figures" / "fig3_8_amplitude_fit.png",
                   results / "figures" / "fig3_5_envelopes.png"]
     assert all(p.is_file() for p in upstream + downstream)
-    modal = work / "src" / "jointcal" / "modal.py"
+    modal = work / "src" / "jointcal" / "measure" / "modal.py"
     modal.write_text(modal.read_text() + "\nraise RuntimeError('a bug in the new modal code')\n")
     res = _snakemake(work, "--cores", "1", *cfg)
     assert res.returncode != 0

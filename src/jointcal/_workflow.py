@@ -4,7 +4,7 @@
 `ast` (every ``import``/``from ... import`` statement, at any depth of the file, relative
 imports resolved, each parent package's ``__init__`` included as Python runs it), so a
 module added later is never forgotten; `stage_hash` is the SHA-256 of those files. The
-workflow passes the hash as a rule's ``params`` so that editing ``jointcal.modal`` reruns
+workflow passes the hash as a rule's ``params`` so that editing ``jointcal.measure.modal`` reruns
 the modal rules and their descendants, and nothing upstream. Not seen: imports built at
 run time (``importlib``), third-party packages, and data files read by the package.
 

@@ -42,12 +42,13 @@ from jointcal.calibrate import CalibrateSettings, read_modal, run_calibration  #
 from jointcal.design import DesignSettings, run_design  # noqa: E402
 from jointcal.design.narrowing import DEPTHS, depth_labels  # noqa: E402
 from jointcal.io import read_manifest, read_run, write_csv_atomic  # noqa: E402
-from jointcal.modal import measure_run, scatter  # noqa: E402
+from jointcal.measure.modal import measure_run  # noqa: E402
+from jointcal.measure.scatter import scatter  # noqa: E402
 from jointcal.posterior import PosteriorSettings, run_posterior  # noqa: E402
 from jointcal.posterior.identified import identified_table, quantities  # noqa: E402
 
 PARAMS = ("Fs", "KT", "chi", "beta", "k", "zeta_v")
-TRUTHS = [  # held-out microslip campaigns: the issue's, the paper's first assembly, a steep dissipation slope
+TRUTHS = [  # held-out microslip campaigns: a moderate chi, the paper's first assembly, a steep dissipation slope
     {"Fs": 282.0, "KT": 1.02e6, "chi": -0.45, "beta": 0.01, "k": 5.4e5, "zeta_v": 0.0015},
     {"Fs": 313.0, "KT": 1.02e6, "chi": -0.65, "beta": 0.004, "k": 6.12e5, "zeta_v": 0.0015},
     {"Fs": 274.0, "KT": 0.90e6, "chi": -0.75, "beta": 0.025, "k": 8.56e5, "zeta_v": 0.0017},

@@ -1,4 +1,4 @@
-"""Acceptance numbers of the input checks (issue 11): run ``python tests/benchmarks/accept_inputs.py``.
+"""Acceptance numbers of the input checks: run ``python tests/benchmarks/accept_inputs.py``.
 
 Prints, for a linear SDOF (2.2 kHz, zeta 0.02) swept 1.8 -> 2.6 kHz at 2000 Hz/s through a
 24-bit ADC clipped at a fraction of the response's resonance peak, at 12.8 and 25.6 kHz:
@@ -21,9 +21,10 @@ sys.path.insert(0, str(HERE.parent))
 
 from test_input_checks import _adc, _longest_flat_top, _row, _sdof_sweep  # noqa: E402
 
-from jointcal._checks import clip_levels, window_amplitudes  # noqa: E402
 from jointcal.io import ingest_campaign, read_manifest, read_run  # noqa: E402
-from jointcal.modal import measure_run  # noqa: E402
+from jointcal.io._amplitudes import window_amplitudes
+from jointcal.io._clipping import clip_levels  # noqa: E402
+from jointcal.measure.modal import measure_run  # noqa: E402
 
 ZETA = 0.02
 

@@ -21,7 +21,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from _modal_helpers import modal_table  # noqa: E402
 from jointcal.calibrate import CalibrateSettings, run_calibration  # noqa: E402
 from jointcal.io import write_csv_atomic  # noqa: E402
-from jointcal.modal import scatter  # noqa: E402
+from jointcal.measure.scatter import scatter  # noqa: E402
 from jointcal.posterior import PosteriorSettings, run_posterior  # noqa: E402
 from jointcal.synth import generate  # noqa: E402
 

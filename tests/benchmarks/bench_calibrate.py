@@ -1,7 +1,7 @@
 """Benchmark: the calibration objective, the GA per assembly and the posterior to 50 tau.
 
 Run:  python tests/benchmarks/bench_calibrate.py
-Prints numbers and ratios measured in this one run. Targets (issue 5): the vectorised
+Prints numbers and ratios measured in this one run. Targets: the vectorised
 objective >= 1e4x faster than evaluating one individual by time-integrating a sweep per
 data point; a GA per assembly (population 200, up to 100 generations) under 10 s; the
 posterior to 50 tau under 60 s; objective evaluations per second for a population of 200.
@@ -74,11 +74,11 @@ def bench_objective(d):
 
 def bench_sweep_objective(d, t_batch, t_near):
     """One individual's model output by time integration: a short sweep through resonance per data point,
-    then the modal stage's own read-out of f_res and zeta from it (jointcal.signal + jointcal.modal)."""
+    then the modal stage's own read-out of f_res and zeta from it (jointcal.measure.envelopes + jointcal.measure.modal)."""
     import pandas as pd
 
-    from jointcal.modal import modal_properties
-    from jointcal.signal import envelopes, meta_dict
+    from jointcal.measure.modal import modal_properties
+    from jointcal.measure.envelopes import envelopes, meta_dict
 
     p = TABLE_3_2["first"]
     iwan = IwanParams(p["Fs"], p["KT"], p["chi"], p["beta"])

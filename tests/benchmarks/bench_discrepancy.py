@@ -31,7 +31,8 @@ from jointcal.calibrate.space import PARAMS
 from jointcal.discrepancy import DiscrepancySettings, diagnose
 from jointcal.discrepancy.stage import valley_starts
 from jointcal.io import read_manifest, read_run, write_csv_atomic
-from jointcal.modal import measure_run, scatter
+from jointcal.measure.modal import measure_run
+from jointcal.measure.scatter import scatter
 from jointcal.models import harmonic_balance
 from jointcal.synth import generate
 

@@ -1,7 +1,7 @@
 """Benchmark: the envelopes stage against a bare ShortTimeFFT.stft on the same samples.
 
 Run:  python tests/benchmarks/bench_envelopes.py
-Target (modal issue): the envelopes of a run (ridge tracking, demodulation of both
+Target: the envelopes of a run (ridge tracking, demodulation of both
 channels and the 2nd/3rd harmonics) take at most twice the time of one bare
 `ShortTimeFFT.stft` of one channel with the same window and hop (ratio >= 0.5).
 """
@@ -15,7 +15,7 @@ from scipy.signal import ShortTimeFFT
 from scipy.signal.windows import hann
 
 from jointcal.io import read_manifest, read_run
-from jointcal.signal import envelopes, window_length
+from jointcal.measure.envelopes import envelopes, window_length
 
 REPO = Path(__file__).resolve().parents[2]
 

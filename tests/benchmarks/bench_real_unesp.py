@@ -24,9 +24,9 @@ import numpy as np
 import pandas as pd
 from scipy import signal
 
-from jointcal.frf import h1_estimate
 from jointcal.io import read_manifest, read_run
-from jointcal.modal import measure_run
+from jointcal.measure.frf import h1_estimate
+from jointcal.measure.modal import measure_run
 from jointcal.models import G
 
 DEFAULT = Path(__file__).resolve().parents[3] / "shared" / "real" / "unesp-bert-mode1"

@@ -2,7 +2,7 @@
 
 Run:  python tests/benchmarks/bench_simulator.py
 Prints wall times, accuracy against a converged reference, and ratios measured in
-this one run (targets from the foundation issue: >= 10x vs the same integrator with a
+this one run (targets: >= 10x vs the same integrator with a
 100-slider Iwan, >= 1000x vs scipy solve_ivp with sliders, >= 500 simulated seconds
 per wall second for one sweep).
 """

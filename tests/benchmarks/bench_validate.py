@@ -1,6 +1,6 @@
 """Benchmark: validating the example campaign (24 runs) with the optimum and 20 posterior draws.
 
-Target (issue 8): under 60 s on 2 cores. Prints the wall time, per-run times (optimum:
+Target: under 60 s on 2 cores. Prints the wall time, per-run times (optimum:
 simulation + measure_run of both records; draws: segment simulations + lock-in), and
 ratios against a baseline measured in the same run (one full-record simulate and one
 measure_run of one record).
@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from jointcal.io import read_manifest, read_run
-from jointcal.modal import measure_run
+from jointcal.measure.modal import measure_run
 from jointcal.models import simulate
 from jointcal.validate import ValidateSettings, model_from_best, model_from_params, models_from_samples, validate_runs
 from jointcal.validate.runs import clean_base

@@ -23,8 +23,8 @@ import pandas as pd
 from scipy import signal
 
 from jointcal.io import write_csv_atomic, write_run
+from jointcal.units import G
 
-G = 386.089  # in/s^2 per g
 MASS = 2.65 / G  # lbf s^2/in (k = MASS * OMEGA**2 is the linear stiffness, lbf/in)
 FN_HZ, ZETA = 2200.0, 0.02
 F_LOW, F_HIGH, RATE, FS = 1500.0, 2900.0, 2000.0, 12800.0  # Hz, Hz, Hz/s, Hz

@@ -8,7 +8,7 @@ from pathlib import Path
 from snakemake.utils import validate
 
 from jointcal._workflow import config_problem, stage_hash
-from jointcal.io import CampaignError, CampaignWarning, read_manifest, write_bytes_atomic
+from jointcal.io import CampaignError, CampaignWarning, excitation_kind, read_manifest, write_bytes_atomic
 
 # Config: an unknown key (a typo) is one line naming the nearest valid key, before the schema's own
 # validation (whose message is a dump of the schema); nested --config values given as text are converted.
@@ -51,8 +51,7 @@ RUN_FILES = {r["run_id"]: str(RAW_DATA / r.get("file", "")) for r in _manifest_r
 RUN_IDS = list(RUN_FILES)
 ASSEMBLIES = list(dict.fromkeys(r["assembly"] for r in _manifest_rows() if r.get("assembly")))
 # the campaign's reference kind from the manifest's level column (base unless level_lbf / level_V)
-EXCITATION = next((k for k, col in (("force", "level_lbf"), ("voltage", "level_V"))
-                   if _manifest_rows() and col in _manifest_rows()[0]), "base")
+EXCITATION = excitation_kind(_manifest_rows()[0]) if _manifest_rows() else "base"
 _CHECKED = []
 
 

@@ -1,4 +1,4 @@
-# Stage envelopes: drive-frequency ridge and complex amplitudes per run (jointcal.signal).
+# Stage envelopes: drive-frequency ridge and complex amplitudes per run (jointcal.measure.envelopes).
 
 rule envelopes_run:
     input:

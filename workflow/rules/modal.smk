@@ -1,4 +1,4 @@
-# Stage modal: resonance, damping and amplitude per run, scatter across repeats (jointcal.modal).
+# Stage modal: resonance, damping and amplitude per run, scatter across repeats (jointcal.measure.modal).
 
 rule modal_properties:
     input:

@@ -10,7 +10,7 @@ from pathlib import Path
 import pandas as pd
 
 from jointcal.io import read_run, write_csv_atomic, write_json_atomic
-from jointcal.signal import envelopes, meta_dict
+from jointcal.measure.envelopes import ENVELOPE_COLUMNS, envelopes, meta_dict
 
 
 def main(smk) -> None:
@@ -22,8 +22,7 @@ def main(smk) -> None:
         meta = {**meta_dict(meta), "error": ""}
         note = f"jointcal: {row['run_id']}: {meta['n_frames']} frames, window {meta['window_s'] * 1e3:.1f} ms"
     except ValueError as exc:
-        env = pd.DataFrame(columns=["time_s", "f_drive_hz", "ref_re", "ref_im", "resp_re", "resp_im", "z_re",
-                                    "z_im", "h2_amp_g", "h3_amp_g", "noise_g", "drive_on", "bad"])
+        env = pd.DataFrame(columns=list(ENVELOPE_COLUMNS))
         meta = {"error": str(exc)}
         note = f"jointcal: warning: {exc}"
         print(note, file=sys.stderr)

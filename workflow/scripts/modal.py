@@ -2,7 +2,7 @@
 
 Every run gets a row; a run with problems gets flags and a one-sentence warning in the
 log and on stderr, never a silent drop. Each run's whole-record FRF (H1, band-averaged
-H2 and coherence, the fitted displacement ratio; `jointcal.frf`) goes to
+H2 and coherence, the fitted displacement ratio; `jointcal.measure.frf`) goes to
 ``frf/<run_id>.csv``. A run the envelope stage could not process (a chirp too short
 for its window) still gets the FRF read-out. (No ``from __future__``: see envelopes.py.)
 """
@@ -12,10 +12,11 @@ from pathlib import Path
 
 import pandas as pd
 
-from jointcal._checks import UNUSABLE_FLAGS
-from jointcal.frf import frf_table
-from jointcal.io import listed_record, read_run, write_csv_atomic
-from jointcal.modal import ENVELOPE_COLUMNS, FLAG_WORDS, modal_properties, scatter
+from jointcal.io import UNUSABLE_FLAGS, listed_record, read_run, write_csv_atomic
+from jointcal.measure.envelopes import ENVELOPE_COLUMNS
+from jointcal.measure.frf import frf_table
+from jointcal.measure.modal import FLAG_WORDS, modal_properties
+from jointcal.measure.scatter import scatter
 
 
 def main(smk) -> None:

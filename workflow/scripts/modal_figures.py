@@ -3,9 +3,9 @@ from pathlib import Path
 
 import pandas as pd
 
-from jointcal.io import listed_record, read_run
+from jointcal.io import level_column, listed_record, read_run
+from jointcal.measure.envelopes import window_length
 from jointcal.report.modal import plot_envelopes, plot_frequency_damping, plot_spectrogram
-from jointcal.signal import window_length
 
 
 def main(smk) -> None:
@@ -14,7 +14,7 @@ def main(smk) -> None:
     envs = {Path(p).stem: pd.read_csv(p) for p in smk.input.env}
     plot_envelopes(table, envs, smk.output.envelopes)
     plot_frequency_damping(table, smk.output.amplitude)
-    level = next((c for c in ("level_g", "level_lbf", "level_V") if c in runs.columns), "level_g")
+    level = level_column(runs.columns) or "level_g"
     rid = runs.sort_values([level, "sequence"]).iloc[-1]["run_id"]  # the strongest run
     row = runs.loc[rid]
     lo = min(row["f_start_hz"], row["f_stop_hz"])

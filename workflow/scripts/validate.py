@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from jointcal.io import listed_record, read_run, write_csv_atomic, write_json_atomic
+from jointcal.io import excitation_kind, listed_record, read_run, write_csv_atomic, write_json_atomic
 from jointcal.validate import ValidateSettings, model_from_best, models_from_samples, validate_runs
 from jointcal.validate.runs import drive_gain
 
@@ -31,7 +31,7 @@ def main(smk) -> None:
         records = [read_run(listed_record(str(r["file"]), list(smk.input.records)), r) for r in rows]
         modal_table = pd.read_csv(smk.input.modal)
         modal = modal_table.set_index("run_id")
-        gain = drive_gain(modal_table[modal_table["assembly"] == asm]) if "base_accel_g" not in records[0] else None
+        gain = drive_gain(modal_table[modal_table["assembly"] == asm]) if excitation_kind(records[0]) != "base" else None
         if gain is not None:  # a force or voltage drives the mode through the campaign's modal constant
             rows = [{**r, "drive_gain": gain} for r in rows]
         f_res = {r["run_id"]: float(modal.loc[r["run_id"], "f_res_hz"]) for r in rows if r["run_id"] in modal.index}
@@ -65,12 +65,12 @@ def main(smk) -> None:
     words = v.words
     if gain is not None:
         words += (f" How the model is driven: the calibrated mode is driven by its modal force per unit modal mass "
-                  f"A(w) r(t), the recorded {'force' if 'force_lbf' in records[0] else 'amplifier voltage'} through "
+                  f"A(w) r(t), the recorded {'force' if excitation_kind(records[0]) == 'force' else 'amplifier voltage'} through "
                   f"the campaign's modal constant A = {gain[0].real:.4g}{gain[0].imag:+.4g}i "
                   f"(in/s^2 per reference unit at {gain[2] / (2 * 3.141592653589793):.4g} Hz, sloped "
                   f"{abs(gain[1]) * gain[2] / abs(gain[0]):.3g} of itself per unit w/w_c), the median over the "
                   "swept-mode fits" + (": the shaker's electrical and residual dynamics in one complex gain; its "
-                                       "back-EMF damping is in the calibrated mode's." if "drive_V" in records[0]
+                                       "back-EMF damping is in the calibrated mode's." if excitation_kind(records[0]) == "voltage"
                                        else "." ))
     summary = {**{k: v.error[k] for k in ("E", "E_mag", "E_phase", "n_runs", "per_level", "scale")},
                "words": words, "assembly": asm, "n_draws": len(draws),

@@ -5,7 +5,7 @@ the damping column named in the config, ``flags``; ``level_g`` or ``level_lbf`` 
 carried along when present) and ``scatter.csv``
 (tidy repeatability: ``assembly, quantity, level_g, source, n, mean, std, rel_std``).
 Rows whose ``flags`` name ``unusable``, or an ingest flag of wrong units or level,
-swapped channels, a constant channel or clipping (`jointcal._checks.UNUSABLE_FLAGS`),
+swapped channels, a constant channel or clipping (`jointcal.io.UNUSABLE_FLAGS`),
 are left out; other flags are informational.
 The pooled relative scatter of the frequency and of the chosen damping estimator is the
 likelihood's noise floor; a missing, zero or tiny pooled value is replaced by a floor
@@ -24,7 +24,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from jointcal._checks import UNUSABLE_FLAGS
+from jointcal.io import UNUSABLE_FLAGS, level_column
 
 __all__ = ["CalibrationInputError", "ModalData", "DAMPING", "select_modal", "read_modal", "read_table"]
 
@@ -167,7 +167,7 @@ def select_modal(modal: pd.DataFrame, assembly: str, *, damping: Damping = "zeta
               else "rerun the modal stage, or check the flags and sweep_note of its runs")
     rows = rows[finite]
     values = {col: pd.to_numeric(rows[col], errors="coerce").to_numpy(float) for col in ("q_in", FREQUENCY, damping)}
-    level_col = next((c for c in ("level_g", "level_lbf", "level_V") if c in rows.columns), None)
+    level_col = level_column(rows.columns)
     level = (np.full(len(rows), np.nan) if level_col is None
              else pd.to_numeric(rows[level_col], errors="coerce").to_numpy(float))
     floors = {"frequency": 1e-4, "damping": 0.01, **(floors or {})}

@@ -28,7 +28,7 @@ from typing import Literal
 import numpy as np
 import pandas as pd
 
-from .._contract import LEVEL
+from ..io._contract import LEVEL, excitation_kind
 
 __all__ = ["KINDS", "Kind", "excitation_of_table", "kind_of", "data_bounds", "model_words"]
 
@@ -38,12 +38,12 @@ KINDS: tuple[str, ...] = ("auto", "ministack", "modal")
 
 def excitation_of_table(modal: pd.DataFrame) -> str:
     """The campaign's excitation, 'base', 'force' or 'voltage', from the modal table's level column."""
-    kinds = [k for k, col in LEVEL.items() if col in modal.columns]
-    if len(kinds) != 1:
+    cols = [col for col in LEVEL.values() if col in modal.columns]
+    if len(cols) != 1:
         raise ValueError("the modal table needs exactly one level column (level_g, level_lbf or level_V), "
                          f"got {', '.join(c for c in modal.columns if str(c).startswith('level')) or 'none'}; "
                          "rerun the modal stage.")
-    return kinds[0]
+    return excitation_kind(cols)
 
 
 def kind_of(requested: str, excitation: str) -> Kind:

@@ -24,7 +24,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from typing import Any, Literal
 
-from ..models import G
+from ..units import G
 from .data import DAMPING
 from .ga import GAOptions
 from .kind import KINDS

@@ -6,7 +6,7 @@ transmissibility response/base, the signed sweep rate, and the repeat-scatter sc
 each frame's magnitude (dB) and phase (deg), the same bins as the validation error E
 (`jointcal.validate.error`); and the run's drive as the envelopes measured it (every such
 frame's time, drive frequency and base amplitude, and the envelopes' window length,
-`jointcal.signal.window_length`), which the swept envelope model follows
+`jointcal.measure.envelopes.window_length`), which the swept envelope model follows
 (`jointcal.models.swept`).
 """
 from __future__ import annotations
@@ -19,7 +19,8 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from ..models import SweepDrive
-from ..signal import window_length
+from ..measure.envelopes import window_length
+from ..measure.peaks import full_drive, transmissibility
 from ..validate.error import BINS
 
 __all__ = ["RunEnvelope", "run_envelope", "run_zeta", "scale_arrays"]
@@ -86,7 +87,7 @@ def run_envelope(env: pd.DataFrame, row: Mapping, sigma_db: NDArray, sigma_deg: 
     Parameters
     ----------
     env : DataFrame
-        The run's envelopes (`jointcal.signal.envelopes`).
+        The run's envelopes (`jointcal.measure.envelopes.envelopes`).
     row : mapping
         Its modal row (f_res_hz, zeta_phase_resonance, flags) merged with the manifest row.
     sigma_db, sigma_deg : ndarray, shape (len(BINS) - 1,)
@@ -104,10 +105,8 @@ def run_envelope(env: pd.DataFrame, row: Mapping, sigma_db: NDArray, sigma_deg: 
     if not (np.isfinite(f_res) and np.isfinite(zeta) and zeta > 0) or "unusable" in str(row.get("flags", "")):
         return None
     ref = (env["ref_re"] + 1j * env["ref_im"]).to_numpy()
-    resp = (env["resp_re"] + 1j * env["resp_im"]).to_numpy()
     f = env["f_drive_hz"].to_numpy(float)
-    ok = env["drive_on"].to_numpy(bool) & ~env["bad"].to_numpy(bool)
-    ok &= np.abs(ref) >= 0.8 * np.median(np.abs(ref[ok])) if ok.any() else ok
+    ok = full_drive(env)
     ok &= (f >= band[0] * f_res) & (f <= band[1] * f_res)
     idx = np.flatnonzero(ok)
     if idx.size < 8:
@@ -121,5 +120,5 @@ def run_envelope(env: pd.DataFrame, row: Mapping, sigma_db: NDArray, sigma_deg: 
     ok_t = np.flatnonzero(ok)
     keep = ok_t[np.r_[True, np.diff(t[ok_t]) > 0]]
     drive = (SweepDrive(t[keep], f[keep], np.abs(ref[keep]), L) if L is not None and keep.size >= 4 else None)
-    return RunEnvelope(f_hz=f[idx], base_g=np.abs(ref[idx]), T=resp[idx] / ref[idx], sigma_db=sigma_db[b],
+    return RunEnvelope(f_hz=f[idx], base_g=np.abs(ref[idx]), T=transmissibility(env)[idx], sigma_db=sigma_db[b],
                        sigma_deg=sigma_deg[b], rate=rate, row=dict(row), t_s=t[idx], drive=drive)

@@ -24,11 +24,11 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..units import G
 from .iwan import derived, dissipation
 
 __all__ = ["jenkins_inphase", "qsma", "harmonic_balance", "resonance_amplitude", "G"]
 
-G = 386.089  # in/s^2 per g
 Viscous = Literal["dashpot", "constant"]
 
 _NODES, _WEIGHTS = np.polynomial.legendre.leggauss(16)

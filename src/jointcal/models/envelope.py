@@ -2,7 +2,7 @@
 
 At each drive frequency f the base acceleration is a_b = A cos(omega t) and the joint
 moves as z = Re(Z e^{i omega t}), |Z| = q. Every nonlinear element of the joint DOF is
-replaced by its describing function at q (PHYSICS.md):
+replaced by its describing function at q (docs/physics.md, sections 2 and 7):
 
 * Iwan joint (eqs. 3.3-3.7): in-phase stiffness KT - R q^(chi+1) J - S (1 - g(phi_max/q))
   (the last term past macroslip) and energy-equivalent damping, i omega c_eq with
@@ -33,7 +33,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _envelope_kernel as _k
-from .amplitude import G, _J
+from ..units import G
+from .amplitude import _J
 from .elements import FIRST_HARMONIC, NAMES, element_table
 from .iwan import derived
 from .structure import MinistackModel

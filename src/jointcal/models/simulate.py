@@ -20,7 +20,7 @@ from scipy.signal import resample_poly
 from collections.abc import Sequence
 
 from . import _integrator
-from .amplitude import G
+from ..units import G
 from ._masing import kernel_constants
 from .elements import CONTACT_SPRING, Element, element_table
 from .iwan import IwanParams, derived

@@ -37,7 +37,7 @@ Two evaluations:
   through the resonance, from the quasi-steady state at x = -`SPAN` (x = (f / f_res - 1) /
   zeta, in sweep order) to x = max(`SPAN`, 1.2 eta) (the ringing has decayed by e^-7
   there), and averaged over each frame's Hann window as the envelopes are (T = <R> / <A>,
-  `jointcal.signal.envelopes`); other frames take `quasi_steady`.
+  `jointcal.measure.envelopes.envelopes`); other frames take `quasi_steady`.
 
 Against the exact-Iwan time simulation measured by the same envelopes (virtual-lab runs,
 12.8 kHz and 10 kHz, 400-1200 Hz/s): the steady state with the former first-order group-delay
@@ -58,7 +58,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _envelope_kernel as _k
-from .amplitude import G
+from ..units import G
 from .envelope import _NODES, _WEIGHTS, _amplitudes, _batch_shape, _field, _joint_terms
 from .structure import MinistackModel
 

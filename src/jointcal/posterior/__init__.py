@@ -2,8 +2,8 @@
 
 Modules: `coords` (sampler coordinates aligned with the identifiable combinations),
 `likelihood` (vectorised log-posteriors of any `ParamSpace`: the modal read-outs with
-sampled noise scales, and residuals over their scatter), `sampler` (emcee in chunks to 50
-tau, resumable, with an early stop when 50 tau is out of reach), `modes` (separated modes
+sampled noise scales, and residuals over their scatter), `sampler` (emcee in chunks to
+tau_factor x tau, resumable, with an early stop when that is out of reach), `modes` (separated modes
 of the draws), `summary` (tables, sentences, predictive band), `fisher` and `identified`
 (what the data identify), `settings` (the ``posterior:`` config section) and `stage` (files).
 """

@@ -7,6 +7,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ..io import level_column
+
 __all__ = ["steady_frames", "plot_envelopes", "plot_frequency_damping", "plot_spectrogram"]
 
 
@@ -46,7 +48,7 @@ def plot_envelopes(table: pd.DataFrame, envs: dict[str, pd.DataFrame], path, ram
     response, which would plot as vertical drops at the band's ends).
     """
     plt = _plt()
-    level = next((c for c in ("level_g", "level_lbf", "level_V") if c in table.columns), "level_g")
+    level = level_column(table.columns) or "level_g"
     unit = level.split("_")[1]
     asms = list(dict.fromkeys(table["assembly"]))
     fig, axes = plt.subplots(1, len(asms), figsize=(5.5 * len(asms), 4.0), squeeze=False, sharey=True)

@@ -20,6 +20,7 @@ import numpy as np
 import pandas as pd
 
 from ..calibrate.space import LOG_SCALED, PARAMS, UNITS
+from ..io import level_column
 
 __all__ = ["rst_escape", "ga_best_point", "bound_hits", "chain_status", "table_3_2_html", "summary_html", "landing_html",
            "fmt"]
@@ -100,7 +101,7 @@ def chain_status(z: Mapping, *, tau_factor: float = 50.0) -> tuple[bool, str]:
     if converged:
         return True, f"converged: {n:.0f} steps = {multiple:.1f} tau (tau {tau:.0f} steps)"
     why = {"max_steps": "stopped at the step cap",
-           "projected": ("stopped early: 50 tau projected to need "
+           "projected": (f"stopped early: {tau_factor:g} tau projected to need "
                          + (f"{float(z['projected_steps']):.0f} steps" if np.isfinite(float(z.get(
                              "projected_steps", np.inf))) else "more steps than any cap (tau grows with the chain)"))}
     return False, (f"NOT converged: {multiple:.1f} tau of the {tau_factor:g} required ({n:.0f} steps, tau {tau:.0f}); "
@@ -256,10 +257,10 @@ def summary_html(*, campaign: str, runs: pd.DataFrame, modal: pd.DataFrame, stat
            "<p><b>Table 3.2</b> (the paper's calibrated parameters, in its layout)</p>", table_html,
            "<h3>Details</h3>"]
     n_asm = runs["assembly"].nunique() if "assembly" in runs else 0
-    level = "level_g" if "level_g" in runs.columns else ("level_lbf" if "level_lbf" in runs.columns else None)
+    level = level_column(runs.columns)
     levels = "" if level is None else ", levels " + ", ".join(f"{v:g}" for v in sorted(runs[level].dropna().unique()))
     out.append(f"<p><b>Campaign</b> <code>{html.escape(campaign)}</code>: {len(runs)} runs on {n_asm} assemblies"
-               f"{html.escape(levels)}{' g' if level == 'level_g' else (' lbf' if level else '')}.</p>")
+               f"{html.escape(levels)}{' ' + level.split('_', 1)[1] if level else ''}.</p>")
     flag_rows = []
     for label, t in (("ingest (runs.csv)", runs), ("modal (modal_properties.csv)", modal)):
         n, detail = _flag_counts(t)

@@ -12,6 +12,7 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 
+from ..io._contract import LEVEL, excitation_kind
 from .calibration import _figure, _png
 
 __all__ = ["validation_figure"]
@@ -42,10 +43,8 @@ def _pick(metrics: pd.DataFrame) -> pd.DataFrame:
 
 def _unit(metrics: pd.DataFrame) -> tuple[str, str]:
     """(level unit, reference name) of a metrics table's runs."""
-    for col, unit, ref in (("level_lbf", "lbf", "force"), ("level_V", "V", "voltage")):
-        if col in metrics.columns and metrics[col].notna().any():
-            return unit, ref
-    return "g", "base"
+    kind = excitation_kind(c for c in metrics.columns if metrics[c].notna().any())
+    return LEVEL[kind].split("_", 1)[1], kind
 
 
 def validation_figure(frames: Mapping[str, Mapping[str, pd.DataFrame]], metrics: Mapping[str, pd.DataFrame],

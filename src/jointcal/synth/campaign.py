@@ -19,7 +19,8 @@ from dataclasses import replace
 
 from ..effects import EFFECTS
 from ..io import write_csv_atomic, write_json_atomic, write_run
-from ..models import G, resonance_amplitude, simulate
+from ..models import resonance_amplitude, simulate
+from ..units import G
 from . import daq
 from .hidden import effect_defaults, run_model
 from .rig_truth import rig_truth

@@ -165,8 +165,8 @@ def _reached(t: NDArray, f_inst: NDArray, x: NDArray, f: float, zeta: float) -> 
 def peak_amplitude(x: NDArray, fs: float, f_hz: float, cutoff: float = 0.45) -> float:
     """The largest amplitude (in) of the displacement x near f_hz: its envelope demodulated at f_hz
     and low-passed at cutoff f_hz (the mode's passage and ring-down; not the drive far from it, other
-    modes or harmonics), the same band as the measured check `jointcal.modal.band_envelope_peak`."""
-    from ..sweepfit import baseband
+    modes or harmonics), the same band as the measured check `jointcal.measure.modal.band_envelope_peak`."""
+    from ..measure.sweepfit import baseband
     return float(np.abs(baseband(np.asarray(x, float), fs, 2 * np.pi * f_hz, cutoff * f_hz)).max())
 
 

@@ -37,13 +37,14 @@ from dataclasses import dataclass, fields
 import numpy as np
 from numpy.typing import NDArray
 
-from ..models import G, MinistackModel
+from ..models import MinistackModel
+from ..units import G, INCH_M, LBF_N
 from ..models.simulate import band_limited, fractional_delay, integrate
 from ..models.structure import StateSpace
 
 __all__ = ["Shaker", "StructureMode", "BL_E_PER_BL", "rig_matrices", "simulate_rig"]
 
-BL_E_PER_BL = 4.448222 * 0.0254  # V/(in/s) of back-EMF per lbf/A of force constant (= 1 in SI)
+BL_E_PER_BL = LBF_N * INCH_M  # V/(in/s) of back-EMF per lbf/A of force constant (= 1 in SI)
 
 
 @dataclass(frozen=True)

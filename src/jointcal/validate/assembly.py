@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from ..io._contract import LEVEL, excitation_kind
 from ..models import MinistackModel
 from .error import describe_misfit, envelope_error, repeat_scatter
 from .runs import (band_frames, compare_run, draw_transmissibility, full_drive_fraction, measure_pair,
@@ -165,5 +166,5 @@ def validate_runs(models: Sequence[MinistackModel] | Callable[[dict], MinistackM
     scale = repeat_scatter(frames, metrics, floor_db=settings.floor_db, floor_deg=settings.floor_deg)
     error = envelope_error(frames, metrics, scale)
     return Validation(metrics=metrics, frames=frames, scale=scale, error=error, traces=traces,
-                      words=describe_misfit(metrics, error, level_unit=next(
-                          (u for c, u in (("level_lbf", "lbf"), ("level_V", "V")) if c in metrics.columns), "g")))
+                      words=describe_misfit(metrics, error, level_unit=LEVEL[excitation_kind(
+                          metrics.columns)].split("_", 1)[1]))

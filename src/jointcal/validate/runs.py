@@ -2,9 +2,9 @@
 
 The simulated record keeps the measured reference channel exactly as recorded (NaN, DC
 offset and all) and replaces the response channel by the model's, so
-`jointcal.modal.measure_run` sees the same reference channel: the same drive ridge, frames,
+`jointcal.measure.modal.measure_run` sees the same reference channel: the same drive ridge, frames,
 window and estimators for both records, and the processing bias cancels. The model is
-driven by the reference cleaned as `jointcal.signal.envelopes` cleans it (NaN gaps bridged
+driven by the reference cleaned as `jointcal.measure.envelopes.envelopes` cleans it (NaN gaps bridged
 linearly here, since the integrator needs a finite input; median removed):
 
 * base-driven (the Ministack): the base acceleration itself;
@@ -13,7 +13,7 @@ linearly here, since the integrator needs a finite input; median removed):
   frequency A(w) = A_c + A' (w - w_c) (held beyond +-45% of w_c) applied line by line to the
   record's spectrum: 1/m for a force at the driving point; for an amplifier voltage the
   rig's electrical and residual dynamics in one complex, frequency-sloped gain, measured by
-  the swept-mode fits (`jointcal.sweepfit`; the campaign's median, ``drive_gain`` in the
+  the swept-mode fits (`jointcal.measure.sweepfit`; the campaign's median, ``drive_gain`` in the
   row). The calibrated mode (the rig's, back-EMF damping included) responds to it as to a
   base acceleration -A r on a fixed base, and its acceleration is that response's.
 
@@ -32,9 +32,12 @@ import pandas as pd
 from numpy.typing import NDArray
 from scipy.signal.windows import hann
 
-from .._contract import REFERENCE
-from ..modal import measure_run
-from ..models import G, MinistackModel, simulate
+from ..io._contract import LEVEL, REFERENCE, excitation_kind, level_column
+from ..measure.modal import measure_run
+from ..measure.peaks import FULL_DRIVE, transmissibility
+from ..measure.peaks import full_drive as full_drive_frames
+from ..models import MinistackModel, simulate
+from ..units import G
 
 __all__ = ["clean_base", "reference_column", "drive_gain", "model_input", "simulate_record", "band_frames",
            "compare_run", "measure_pair", "time_envelopes", "draw_transmissibility"]
@@ -121,18 +124,14 @@ def simulate_record(model: MinistackModel, record: pd.DataFrame, row: Mapping) -
     return out
 
 
-def _transmissibility(env: pd.DataFrame) -> NDArray[np.complex128]:
-    return ((env["resp_re"] + 1j * env["resp_im"]) / (env["ref_re"] + 1j * env["ref_im"])).to_numpy()
-
-
-HEAD = ("run_id", "assembly", "sequence", "level_g", "level_lbf", "level_V", "direction")
+HEAD = ("run_id", "assembly", "sequence", *LEVEL.values(), "direction")
 
 
 def run_head(row: Mapping) -> dict:
     """A run's identity for the tables: run_id, assembly, sequence, its level column, direction, and
     ``level``, the level in its own unit (g, lbf or V) whatever the reference."""
     head = {k: row[k] for k in HEAD if k in row}
-    head["level"] = next((float(row[k]) for k in ("level_g", "level_lbf", "level_V") if k in row), np.nan)
+    head["level"] = float(row[level_column(row)]) if level_column(row) else np.nan
     return head
 
 
@@ -143,11 +142,8 @@ def band_frames(env: pd.DataFrame, f_res_hz: float, band: Sequence[float], *,
     full_drive 0.8 leaves out a controlled drive's ramps (a ringing response over a vanishing
     base); an open-loop force drops out at resonance by physics, and takes 0.05.
     """
-    ref = np.abs((env["ref_re"] + 1j * env["ref_im"]).to_numpy())
-    on = env["drive_on"].to_numpy(bool) & ~env["bad"].to_numpy(bool)
-    full = ref >= full_drive * np.median(ref[on]) if on.any() else on
     f = env["f_drive_hz"].to_numpy()
-    return on & full & (f >= band[0] * f_res_hz) & (f <= band[1] * f_res_hz)
+    return full_drive_frames(env, full_drive) & (f >= band[0] * f_res_hz) & (f <= band[1] * f_res_hz)
 
 
 def _on_grid(f_src: NDArray, T: NDArray, f_dst: NDArray) -> NDArray[np.complex128]:
@@ -166,7 +162,7 @@ def _phase_deg(T: NDArray) -> NDArray[np.float64]:
 
 def full_drive_fraction(props: Mapping) -> float:
     """`band_frames`' full-drive fraction for a run: 0.05 for a force reference, else 0.8."""
-    return 0.05 if "level_lbf" in props else 0.8
+    return 0.05 if excitation_kind(props) == "force" else FULL_DRIVE
 
 
 def compare_run(env_m: pd.DataFrame, props_m: Mapping, env_s: pd.DataFrame, props_s: Mapping, *,
@@ -177,9 +173,9 @@ def compare_run(env_m: pd.DataFrame, props_m: Mapping, env_s: pd.DataFrame, prop
     Parameters
     ----------
     env_m, env_s : DataFrame
-        Envelopes of the measured and simulated records (`jointcal.signal.envelopes`).
+        Envelopes of the measured and simulated records (`jointcal.measure.envelopes.envelopes`).
     props_m, props_s : mapping
-        Their modal rows (`jointcal.modal.modal_properties`).
+        Their modal rows (`jointcal.measure.modal.modal_properties`).
     band : (lo, hi)
         Compared band as fractions of the measured resonance frequency f_res_hz.
     zeta_key : str
@@ -203,9 +199,9 @@ def compare_run(env_m: pd.DataFrame, props_m: Mapping, env_s: pd.DataFrame, prop
     use_m = band_frames(env_m, f_res, (0.0, np.inf), full_drive=fd)
     use_s = band_frames(env_s, f_res, (0.0, np.inf), full_drive=fd)
     f = env_m["f_drive_hz"].to_numpy()[use_m]
-    T_m = _transmissibility(env_m)[use_m]
+    T_m = transmissibility(env_m)[use_m]
     f_s = env_s["f_drive_hz"].to_numpy()[use_s]
-    T_s = _on_grid(f_s, _transmissibility(env_s)[use_s], f)
+    T_s = _on_grid(f_s, transmissibility(env_s)[use_s], f)
     R_s = _on_grid(f_s, (env_s["resp_re"] + 1j * env_s["resp_im"]).to_numpy()[use_s], f)
     inside = (f >= min(f_s, default=np.inf)) & (f <= max(f_s, default=-np.inf))
     d = T_s / T_m
@@ -257,10 +253,10 @@ def time_envelopes(record: pd.DataFrame, sim_record: pd.DataFrame, f_hz: float, 
 
     A chirp faster than the mode (or its free decay) is not a sequence of steady states, and
     the drive-frequency frames hold few points near resonance; the response's band-limited
-    envelope (`jointcal.sweepfit.baseband` at f_hz, low-passed at 0.45 f_hz) shows the passage
+    envelope (`jointcal.measure.sweepfit.baseband` at f_hz, low-passed at 0.45 f_hz) shows the passage
     and the ring-down as they were. Columns time_s, resp_meas_g, resp_sim_g; at most n_max rows.
     """
-    from ..sweepfit import baseband
+    from ..measure.sweepfit import baseband
 
     out = {}
     for name, rec in (("meas", record), ("sim", sim_record)):

@@ -1,7 +1,7 @@
 """Clipping of a recorded channel: the pile-up of samples at an ADC's full scale.
 
-Private: `jointcal._checks` flags clipped channels with `clip_levels`; the envelopes
-leave out the samples `clipped_mask` marks (re-exported by `jointcal._checks`).
+Private: `jointcal.io._checks` flags clipped channels with `clip_levels`; the envelopes
+leave out the samples `clipped_mask` marks (re-exported by `jointcal.io._checks`).
 """
 from __future__ import annotations
 

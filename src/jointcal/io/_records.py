@@ -1,15 +1,6 @@
-"""Raw-data contract: read and validate a swept-sine campaign; write files atomically.
+"""Read one run record (the contract's CSV or MAT, or a lab's export) and a whole campaign.
 
-A campaign folder holds ``manifest.csv`` (one row per run) and one record per run
-(``.csv``, ``.csv.gz`` or MATLAB ``.mat``) with the columns ``time_s`` (s),
-``base_accel_g`` (g) or, for force-driven tests, ``force_lbf`` (lbf), or, for a
-shaker driven open-loop, ``drive_V`` (amplifier voltage, V), and ``response_accel_g``
-(g) or ``response_accel_m_s2`` (m/s^2, converted to g on read); 1 g = 386.089 in/s^2
-= 9.80665 m/s^2. A record may also be a lab's own export (UFF 58, NI TDMS, Test.Lab
-MATLAB; `jointcal._lab_formats`) whose channels the manifest names. ``raw_data/README.md``
-states the contract for people; every violation raises `CampaignError` with one sentence
-that names the file, the problem and the fix. File I/O of the package lives here (the
-manifest reader, the checks and the writers are in private helper modules and re-exported).
+Private: `jointcal.io` re-exports `read_run`, `ingest_campaign` and `listed_record`.
 """
 from __future__ import annotations
 
@@ -23,20 +14,16 @@ import pandas as pd
 import scipy.io
 from numpy.typing import NDArray
 
-from jointcal._atomic import write_bytes_atomic, write_csv_atomic, write_json_atomic, write_run
-from jointcal._checks import validate_run
-from jointcal._contract import (
-    CHANNEL_COLUMNS, G_SI, LEVEL, REFERENCE, RESPONSE, RESPONSE_SI, START, TIME, CampaignError, CampaignWarning,
-    Excitation, OnDataProblem, excitation_of, fail,
+from jointcal.io._checks import validate_run
+from jointcal.io._contract import (
+    CHANNEL_COLUMNS, LEVEL, REFERENCE, RESPONSE, RESPONSE_SI, START, TIME, Excitation, OnDataProblem,
+    excitation_kind, excitation_of, fail,
 )
-from jointcal._lab_formats import LAB_SUFFIXES, is_testlab, read_lab_export
-from jointcal._manifest import check_csv_text, read_manifest
+from jointcal.io._lab_formats import LAB_SUFFIXES, is_testlab, read_lab_export
+from jointcal.io._manifest import check_csv_text, read_manifest
+from jointcal.units import G_SI
 
-__all__ = [
-    "CampaignError", "CampaignWarning", "read_manifest", "read_run", "validate_run",
-    "ingest_campaign", "listed_record", "write_bytes_atomic", "write_csv_atomic", "write_json_atomic",
-    "write_run",
-]
+__all__ = ["read_run", "ingest_campaign", "listed_record"]
 
 
 def read_run(path: str | os.PathLike[str], row: Mapping[str, Any] | None = None) -> pd.DataFrame:
@@ -50,7 +37,7 @@ def read_run(path: str | os.PathLike[str], row: Mapping[str, Any] | None = None)
         ``time_s,drive_V,response_accel_g``; a response in m/s^2 is declared by naming
         its column ``response_accel_m_s2``), gzip-compressed CSV, or a MATLAB v5/v7
         file holding variables of those names as row or column vectors (other
-        variables are ignored); or a lab's export (`jointcal._lab_formats`): UFF 58
+        variables are ignored); or a lab's export (`jointcal.io._lab_formats`): UFF 58
         (``.uff``, ``.unv``), NI TDMS (``.tdms``) or a Simcenter Test.Lab MATLAB export
         (``.mat`` holding structs with ``x_values`` and ``y_values``).
     row : mapping, optional
@@ -108,8 +95,8 @@ def _cell(row: Mapping[str, Any] | None, col: str) -> str | None:
 
 
 def _row_excitation(row: Mapping[str, Any] | None) -> Excitation | None:
-    """The excitation the row's level column gives, None without a row."""
-    return None if row is None else next((k for k, c in LEVEL.items() if _cell(row, c) is not None), None)
+    """The excitation the row's (non-empty) level column gives, None without a row or level."""
+    return None if row is None else excitation_kind([c for c in LEVEL.values() if _cell(row, c) is not None], None)
 
 
 def _from_sweep_start(df: pd.DataFrame, row: Mapping[str, Any] | None, path: Path) -> pd.DataFrame:

@@ -1,7 +1,7 @@
 """Amplitude checks of one run record: swapped channels, the reference against the manifest's level,
 and (base-driven) the response's units from its ratio to the base below resonance.
 
-Private: `jointcal._checks.validate_run` reports what these find as flags
+Private: `jointcal.io._checks.validate_run` reports what these find as flags
 (``swapped``, ``level``, ``units``).
 """
 from __future__ import annotations
@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from jointcal._contract import LEVEL, MIN_CYCLES, QUANTITY, REFERENCE, RESPONSE, UNITS
+from jointcal.io._contract import LEVEL, MIN_CYCLES, QUANTITY, REFERENCE, RESPONSE, UNITS
 
 __all__ = ["window_amplitudes", "swap_problem", "level_problems", "low_frequency_ratio"]
 

@@ -18,11 +18,15 @@ from numpy.typing import NDArray
 from scipy.signal import ShortTimeFFT, savgol_filter
 from scipy.signal.windows import hann
 
-from ._checks import clipped_mask
-from ._contract import REFERENCE, RESPONSE
-from .models import G
+from ..io._clipping import clipped_mask
+from ..io._contract import REFERENCE, RESPONSE, excitation_kind
+from ..units import G
+from .peaks import parabola_vertex
 
-__all__ = ["EnvelopeMeta", "window_length", "track_drive", "envelopes", "meta_dict"]
+__all__ = ["EnvelopeMeta", "window_length", "track_drive", "envelopes", "meta_dict", "ENVELOPE_COLUMNS"]
+
+ENVELOPE_COLUMNS = ("time_s", "f_drive_hz", "ref_re", "ref_im", "resp_re", "resp_im", "z_re", "z_im", "h2_amp_g",
+                    "h3_amp_g", "noise_g", "drive_on", "bad")  # one row per frame
 
 
 @dataclass(frozen=True)
@@ -81,11 +85,9 @@ def track_drive(ref: NDArray, fs: float, n_win: int, hop: int, f_band: tuple[flo
     k = ib[np.argmax(S[ib], axis=0)]
     k = np.clip(k, 1, S.shape[0] - 2)
     j = np.arange(S.shape[1])
-    a, b, c = (np.log(S[k + d, j] + 1e-300) for d in (-1, 0, 1))  # Gaussian-peak refinement
-    den = a - 2 * b + c
-    delta = np.where(den < 0, 0.5 * (a - c) / np.where(den < 0, den, -1.0), 0.0)
+    delta, top = parabola_vertex(*(np.log(S[k + d, j] + 1e-300) for d in (-1, 0, 1)))  # Gaussian-peak refinement
     f = (k + np.clip(delta, -0.5, 0.5)) * stft.delta_f
-    mag = 2.0 * np.exp(b - 0.25 * (a - c) * delta)
+    mag = 2.0 * np.exp(top)
     t_c = stft.t(ref.size, p0=p0, p1=p1)
     return t_c, f, mag, mfft
 
@@ -131,7 +133,7 @@ def envelopes(df: pd.DataFrame, row: dict, *, zeta_min: float = 0.01, hop_fracti
     meta : EnvelopeMeta
     """
     fs = float(row["sample_rate_hz"])
-    kind = next((k for k, c in REFERENCE.items() if c in df.columns), "base")
+    kind = excitation_kind(df.columns)
     ref = df[REFERENCE[kind]].to_numpy(dtype=float)
     resp = df[RESPONSE].to_numpy(dtype=float)
     # NaN/inf and clipped samples (the ingest stage's definition) are left out

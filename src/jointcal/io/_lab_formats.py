@@ -36,7 +36,7 @@ import numpy as np
 import scipy.io
 from numpy.typing import NDArray
 
-from jointcal._contract import (
+from jointcal.io._contract import (
     CHANNEL_COLUMNS, QUANTITY, REFERENCE, RESPONSE, TIME, UNITS, Excitation, fail,
 )
 

@@ -1,11 +1,14 @@
-"""The raw-data contract's names and errors, shared by `jointcal.io` and its helpers.
+"""The raw-data contract's names and errors, and the one rule that tells a run's excitation.
 
-Private: `jointcal.io` re-exports `CampaignError` and `CampaignWarning`.
+Private: `jointcal.io` re-exports `CampaignError`, `CampaignWarning`, `excitation_kind`
+and `level_column`.
 """
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from typing import Literal, NoReturn
+
+from jointcal.units import FOOT_IN, G, G_SI, LBF_N
 
 __all__: list[str] = []
 
@@ -17,7 +20,7 @@ TIME, RESPONSE = "time_s", "response_accel_g"
 REFERENCE: dict[str, str] = {"base": "base_accel_g", "force": "force_lbf", "voltage": "drive_V"}
 LEVEL: dict[str, str] = {"base": "level_g", "force": "level_lbf", "voltage": "level_V"}  # manifest column
 # a response exported in m/s^2 under this name is converted to g (RESPONSE) on read
-RESPONSE_SI, G_SI = "response_accel_m_s2", 9.80665  # m/s^2 per g
+RESPONSE_SI = "response_accel_m_s2"
 TEXT = ("run_id", "assembly", "direction", "file")
 START = "sweep_start_s"  # optional manifest column: the sweep's start after the record's first sample (s)
 # optional manifest columns naming a lab format's channels: role -> column
@@ -27,9 +30,9 @@ POSITIVE = ("f_start_hz", "f_stop_hz", "sweep_rate_hz_per_s", "sample_rate_hz")
 QUANTITY: dict[str, str] = {"base": "acceleration", "force": "force", "voltage": "voltage"}
 # the size of each unit a lab file may use, in the contract's unit of its quantity (g, lbf, V, s)
 UNITS: dict[str, dict[str, float]] = {
-    "acceleration": {"g": 1.0, "m/s^2": 1.0 / G_SI, "in/s^2": 1.0 / 386.089, "ft/s^2": 1.0 / 32.174,
+    "acceleration": {"g": 1.0, "m/s^2": 1.0 / G_SI, "in/s^2": 1.0 / G, "ft/s^2": FOOT_IN / G,
                      "mm/s^2": 1e-3 / G_SI},
-    "force": {"lbf": 1.0, "N": 1.0 / 4.4482216, "kN": 1e3 / 4.4482216},
+    "force": {"lbf": 1.0, "N": 1.0 / LBF_N, "kN": 1e3 / LBF_N},
     "voltage": {"V": 1.0, "mV": 1e-3},
     "time": {"s": 1.0, "ms": 1e-3},
 }
@@ -52,6 +55,36 @@ for _cls in (CampaignError, CampaignWarning):
 def fail(where: object, problem: str, fix: str) -> NoReturn:
     """Raise `CampaignError` with the sentence ``"<where>: <problem>; <fix>."``."""
     raise CampaignError(f"{where}: {problem}; {fix}.")
+
+
+def excitation_kind(names: Iterable[object], default: Excitation | None = "base") -> Excitation | None:
+    """The excitation a set of names shows: 'base', 'force' or 'voltage'.
+
+    The one place that decides it: a record's reference column (``base_accel_g``,
+    ``force_lbf``, ``drive_V``) first, else a level column (``level_g``, ``level_lbf``,
+    ``level_V``, as a manifest row, runs.csv, modal_properties.csv or a metrics table carry
+    it), each looked for in that order.
+
+    Parameters
+    ----------
+    names : iterable
+        Column names of a record or table, or the keys of a row (a mapping iterates its keys).
+    default : {'base', 'force', 'voltage'} or None, optional
+        The answer when no name is a reference or level column.
+
+    Returns
+    -------
+    str or None
+    """
+    names = {str(n) for n in names}
+    return next((k for k, c in REFERENCE.items() if c in names), None) or \
+        next((k for k, c in LEVEL.items() if c in names), default)
+
+
+def level_column(names: Iterable[object]) -> str | None:
+    """The level column among `names` (``level_g``, ``level_lbf`` or ``level_V``, in that order); None if none."""
+    names = {str(n) for n in names}
+    return next((c for c in LEVEL.values() if c in names), None)
 
 
 def excitation_of(names: Sequence[str], where: object, *, expected: Excitation | None = None,

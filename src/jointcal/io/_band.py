@@ -1,0 +1,93 @@
+"""The drive's frequency at a record's start and end, checked against the manifest's band.
+
+Private: `jointcal.io._checks.validate_run` calls `drive_band` and `check_head`.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from jointcal.io._contract import MIN_CYCLES, fail
+from jointcal.measure.peaks import parabola_vertex
+
+__all__ = ["peak_frequency", "drive_band", "check_head"]
+
+HEAD_LEVEL = 0.1  # a head quieter than this fraction of the reference's amplitude is silent
+
+
+def peak_frequency(x: NDArray[np.float64], fs: float, *, pad: int = 16) -> float:
+    """Frequency of the largest spectral peak of a short record (Hz).
+
+    Parameters
+    ----------
+    x : ndarray of float, shape (n,)
+        Short record (any unit); non-finite samples are treated as 0.
+    fs : float
+        Sample rate (Hz).
+    pad : int, optional
+        Zero-padding factor of the FFT (the peak is then refined by a parabola
+        through the three highest bins of the log magnitude).
+
+    Returns
+    -------
+    float
+        Peak frequency (Hz) of the Hann-windowed, mean-removed record. For a
+        linear chirp this is the instantaneous frequency at the record's centre.
+    """
+    y = np.nan_to_num(np.asarray(x, dtype=np.float64), nan=0.0, posinf=0.0, neginf=0.0)
+    y = (y - y.mean()) * np.hanning(y.size)
+    nfft = pad * y.size
+    mag = np.abs(np.fft.rfft(y, nfft))
+    mag[: pad + 1] = 0.0  # ignore DC and the first bin: the record is mean-removed
+    k = int(np.argmax(mag))
+    if 0 < k < mag.size - 1 and mag[k] > 0:
+        k = k + float(parabola_vertex(*np.log(mag[k - 1 : k + 2] + 1e-300))[0])  # on the log magnitude
+    return float(k * fs / nfft)
+
+
+def check_head(drive: NDArray[np.float64], amp: NDArray[np.float64], fs: float, f0: float, f1: float, rate: float,
+                path: object, run: str, band: str) -> None:
+    """Fail naming a silent pre-trigger head when the record, from the drive's onset on, fits the manifest band.
+
+    The head ends where the drive (median removed) first exceeds ``HEAD_LEVEL`` of its
+    median window amplitude `amp`; the onset is the first sample above six times the
+    head's noise (robust RMS of its first half), which finds the start of a ramp too.
+    """
+    if amp.size == 0 or not np.median(amp) > 0:
+        return
+    x = np.nan_to_num(np.abs(drive - np.nanmedian(drive)))
+    i_head = int(np.argmax(x > HEAD_LEVEL * float(np.median(amp))))
+    if i_head < 2:
+        return
+    noise = 1.4826 * float(np.median(x[: i_head // 2 + 1]))
+    i_on = int(np.argmax(x[: i_head + 1] > 6.0 * noise)) if noise > 0 else i_head
+    if i_on == 0 or drive.size - i_on < 0.95 * abs(f1 - f0) / rate * fs:
+        return
+    first, last, tol = drive_band(drive[i_on:], fs, f0, f1, rate)
+    if abs(first - f0) <= tol and abs(last - f1) <= tol:
+        fail(path, f"the drive starts {i_on / fs:.4g} s after the record's first sample (a silent pre-trigger head "
+             f"of {i_on} samples), so the record does not start with the sweep {band}",
+             f"trim the head so that the record starts with the sweep, or give the sweep's start in the manifest's "
+             f"sweep_start_s column ({i_on / fs:.4g} for run {run})")
+
+
+def drive_band(ref: NDArray[np.float64], fs: float, f0: float, f1: float,
+                rate: float) -> tuple[float, float, float]:
+    """Drive frequency (Hz) at the sweep's start and expected end, and the tolerance (Hz).
+
+    `ref` is the reference channel sampled at `fs` (Hz) from the sweep's start; the sweep
+    runs linearly from `f0` to `f1` (Hz) at `rate` (Hz/s). Each window's peak frequency
+    is the frequency at the window's centre, referred to the sweep's start or end with
+    `rate`.
+    """
+    sign = 1.0 if f1 > f0 else -1.0
+    sweep_s = abs(f1 - f0) / rate
+    win = min(max(MIN_CYCLES / min(f0, f1), np.sqrt(2.0 / rate)), sweep_s / 4)
+    nw = max(int(round(win * fs)), 8)
+    tol = rate * (nw / fs) / 2 + fs / nw  # half the sweep within a window + one FFT bin
+    i_end = min(ref.size, int(round(sweep_s * fs)))
+    centre_first = (nw - 1) / 2 / fs  # s after the sweep's start
+    centre_last = (2 * i_end - nw - 1) / 2 / fs
+    f_first = peak_frequency(ref[:nw], fs) - sign * rate * centre_first
+    f_last = peak_frequency(ref[i_end - nw:i_end], fs) + sign * rate * (sweep_s - centre_last)
+    return f_first, f_last, tol
