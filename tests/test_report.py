@@ -11,7 +11,8 @@ from jointcal.posterior import find_modes, mode_labels, modes_text
 from jointcal.report.calibration import exploration_figure
 from jointcal.report.corner import corner_figure
 from jointcal.report.modal import steady_frames
-from jointcal.report.summary import bound_hits, chain_status, ga_best_point, landing_html, table_3_2_html
+from jointcal.report.summary import bound_hits, chain_status, ga_best_point, landing_html
+from jointcal.report.table_3_2 import table_3_2_html
 from jointcal.report.verdict import named_effects, verdict_html, verdict_items
 
 BOUNDS = CalibrateSettings().full_bounds  # the Ministack kind's defaults

@@ -14,7 +14,8 @@ import pandas as pd
 from jointcal.calibrate import PARAMS, CalibrateSettings, model_words, read_modal
 from jointcal.io import write_bytes_atomic
 from jointcal.posterior import NAMES, PosteriorSettings, find_modes
-from jointcal.report.summary import bound_hits, chain_status, ga_best_point, landing_html, summary_html, table_3_2_html
+from jointcal.report.summary import bound_hits, chain_status, ga_best_point, landing_html, summary_html
+from jointcal.report.table_3_2 import table_3_2_html
 from jointcal.posterior.identified import identified_at
 from jointcal.report.verdict import corrected_holds, identified_html, verdict_html, verdict_items
 

@@ -21,13 +21,12 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field, fields
 
 import numpy as np
 import pandas as pd
 
 from ..calibrate.space import PARAMS, ParamSpace
-from ..effects import effects_of, library
+from ..effects import effects_of
 from ..models import harmonic_balance
 from ..validate import ValidateSettings, model_from_best, validate_runs
 from .data import run_envelope, scale_arrays
@@ -36,50 +35,11 @@ from .fit import candidate, fit_candidate, model_at, with_transient
 from .floor import fast_floor
 from .recalibrate import recalibrate
 from .rule import CLAUSES, confirm, decide
+from .settings import DiscrepancySettings
 from .select import needs_pairs, pair_bases, pair_names, score_candidates
 from .words import diagnosis_markdown
 
 __all__ = ["DiscrepancySettings", "diagnose", "diagnosis_markdown", "valley_starts"]
-
-
-@dataclass(frozen=True)
-class DiscrepancySettings:
-    """The ``discrepancy:`` config section: candidates (library names), band (fractions of f_res),
-    max_frames per run, max_nfev of each least-squares fit, the recalibration's GA generations and
-    posterior steps, and its seed."""
-
-    candidates: tuple[str, ...] = field(default_factory=library)
-    band: tuple[float, float] = (0.6, 1.4)
-    max_frames: int = 80
-    max_nfev: int = 25
-    ga_generations: int = 30
-    posterior_steps: int = 800
-    seed: int = 2017
-
-    def __post_init__(self) -> None:
-        bad = [c for c in self.candidates if c not in library()]
-        if bad:
-            raise ValueError(f"discrepancy.candidates: unknown effect(s) {', '.join(bad)}; the library has "
-                             f"{', '.join(library())}.")
-        if not (0 < self.band[0] < 1 < self.band[1]):
-            raise ValueError(f"discrepancy.band must be [lo, hi] with 0 < lo < 1 < hi, got {list(self.band)!r}.")
-        if self.ga_generations < 1 or self.posterior_steps < 100:
-            raise ValueError("discrepancy.ga_generations must be >= 1 and posterior_steps >= 100, got "
-                             f"{self.ga_generations!r} and {self.posterior_steps!r}.")
-        if self.max_frames < 16 or self.max_nfev < 5:
-            raise ValueError("discrepancy.max_frames must be >= 16 and max_nfev >= 5, got "
-                             f"{self.max_frames!r} and {self.max_nfev!r}.")
-
-    @classmethod
-    def from_config(cls, section: Mapping | None) -> DiscrepancySettings:
-        section = dict(section or {})
-        unknown = sorted(set(section) - {f.name for f in fields(cls)})
-        if unknown:
-            raise ValueError(f"discrepancy: unknown key(s) {', '.join(unknown)}")
-        for key in ("candidates", "band"):
-            if key in section:
-                section[key] = tuple(section[key])
-        return cls(**section)
 
 
 def valley_starts(history: pd.DataFrame, best: Mapping, *, n: int = 3, rel: float = np.inf) -> list[list[float]]:
@@ -147,23 +107,75 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     eq. 3.9 leaves the Fs-KT split flat, the envelopes may not).
     """
     say = log or (lambda s: None)
-    t_start = time.perf_counter()
-    clock = {}
-
-    def lap(step: str) -> None:  # seconds per step of the stage, for diagnosis.json
-        clock[step] = time.perf_counter() - t_start - sum(clock.values())
+    clock = _Clock()
     m = float(best["m"])
     theta0 = np.array([best[p] for p in PARAMS], dtype=float)
+    vkw = dict(settings=validate_settings, envelopes_kw=envelopes_kw, modal_kw=modal_kw, executor=executor)
     if scale is None or frames_before is None:  # as the validation stage does: the calibrated model in time
-        v_before = validate_runs([model_from_best(best) for _ in rows], records, rows, settings=validate_settings,
-                                 envelopes_kw=envelopes_kw, modal_kw=modal_kw, executor=executor)
+        v_before = validate_runs([model_from_best(best) for _ in rows], records, rows, **vkw)
         scale = v_before.scale.to_dict(orient="records") if scale is None else scale
         frames_before = v_before.frames
         metric_before = float(v_before.error["E"]) if metric_before is None else metric_before
-    lap("validate_before")
+    clock.lap("validate_before")
     sdb, sdeg = scale_arrays(scale)
     mrows = modal[modal["assembly"] == assembly].set_index("run_id")
-    zeta_min = float((envelopes_kw or {}).get("zeta_min", 0.01))
+    runs = _usable_runs(assembly, envs, mrows, rows, sdb, sdeg, settings, float((envelopes_kw or {}).get("zeta_min", 0.01)))
+    say(f"{assembly}: {len(runs)} usable runs, {sum(r.f_hz.size for r in runs)} envelope frames")
+    c0 = candidate("baseline", space, m)
+    floor = fast_floor(c0, theta0, runs, frames_before, sdb, sdeg)
+    F = floor["E"] if floor["E"] is not None else 0.0
+    say(f"{assembly}: the fast model's floor (its envelope of the calibrated model against the time simulation) "
+        f"E = {F:.2f}" + ("" if floor["E"] is not None else " (no validation frames to compare: taken as 0)"))
+    clock.lap("floor")
+    scored, pairs_tried = _score_library(assembly, space, m, runs, theta0, F, settings, joint_starts, clock, say)
+    base = next(s for s in scored if s.name == "baseline")
+    res, fp, ver, outside = _localise(c0, base, runs, mrows, m, sdb)
+    decision = decide(scored, outside, floor=F)
+    effect, confidence, ranked = decision.effect, decision.confidence, decision.ranked
+    named = next((s for s in ranked if s.name == effect), None)
+    final, cf, rec, n_fits = _recalibrated(assembly, named if named is not None else base, space, m, runs,
+                                           joint_starts, settings, say)
+    clock.lap("recalibrate")
+    say(f"{assembly}: decision {effect} ({confidence}); revalidating with the time simulation")
+    v_after = validate_runs([model_at(cf, final.fit.theta, r) for r in rows], records, rows, **vkw)
+    if metric_before is None:
+        metric_before = float(validate_runs([model_from_best(best) for _ in rows], records, rows, **vkw).error["E"])
+    metric_after = float(v_after.error["E"])
+    clock.lap("validate_after")
+    effect, confidence, time_note = confirm(effect, confidence, float(metric_before), metric_after)
+    diagnosis = {
+        "assembly": assembly, "effect": effect, "effects": list(effects_of(effect)) if effect not in (
+            "none", "unexplained") else [], "confidence": confidence, "rule": decision.rule,
+        "rule_applied": [*decision.applied, *([CLAUSES[time_note]] if time_note else [])],
+        "outside_library": outside,
+        "fast_model_floor": floor, "time_domain_check": time_note,
+        "baseline": {"held_out_score": base.score, "E_fit": base.fit.E, "held_out_E_per_level": base.held_out,
+                     "joint_parameters": c0.grown.named(base.fit.theta, PARAMS)},
+        "candidates": [_candidate_json(s, space, m, ver) for s in ranked], "pairs_tried": pairs_tried,
+        "fingerprints": fp, "metric_before": float(metric_before), "metric_after": metric_after,
+        "metric_change": metric_after / metric_before - 1.0 if metric_before else None,
+        "recalibrated": _recalibrated_json(final, cf, rec, n_fits),
+        "calibration_joint_parameters": dict(zip(PARAMS, map(float, theta0))),
+        "words_after": v_after.words, "seconds": clock.total(), "seconds_per_step": clock.steps,
+    }
+    return {"diagnosis": diagnosis, "residuals": res, "validation_after": v_after}
+
+
+class _Clock:
+    """Seconds per step of the stage, for diagnosis.json."""
+
+    def __init__(self) -> None:
+        self.start, self.steps = time.perf_counter(), {}
+
+    def lap(self, step: str) -> None:
+        self.steps[step] = time.perf_counter() - self.start - sum(self.steps.values())
+
+    def total(self) -> float:
+        return time.perf_counter() - self.start
+
+
+def _usable_runs(assembly, envs, mrows, rows, sdb, sdeg, settings, zeta_min) -> list:
+    """The assembly's runs with envelopes and a modal row, as `RunEnvelope`s; at least two."""
     runs = []
     for row in rows:
         rid = row["run_id"]
@@ -176,19 +188,20 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     if len(runs) < 2:
         raise ValueError(f"assembly {assembly}: {len(runs)} usable run(s); the discrepancy workflow needs at "
                          "least two usable runs (at two levels to score held-out levels).")
-    say(f"{assembly}: {len(runs)} usable runs, {sum(r.f_hz.size for r in runs)} envelope frames")
-    c0 = candidate("baseline", space, m)
-    floor = fast_floor(c0, theta0, runs, frames_before, sdb, sdeg)
-    F = floor["E"] if floor["E"] is not None else 0.0
-    say(f"{assembly}: the fast model's floor (its envelope of the calibrated model against the time simulation) "
-        f"E = {F:.2f}" + ("" if floor["E"] is not None else " (no validation frames to compare: taken as 0)"))
-    lap("floor")
-    cands = [c0] + [candidate(n, space, m) for n in settings.candidates]
+    return runs
+
+
+def _score_library(assembly, space, m, runs, theta0, F, settings, joint_starts, clock, say):
+    """Every candidate refit and scored on held-out folds; pairs by forward selection when no single
+    effect closes the gap (the bases refit from the calibration's other valleys first).
+
+    Returns the scored candidates and the pairs tried."""
+    cands = [candidate("baseline", space, m)] + [candidate(n, space, m) for n in settings.candidates]
     scored = score_candidates(cands, runs, theta0, max_nfev=settings.max_nfev, log=say)
     base = next(s for s in scored if s.name == "baseline")
-    lap("singles")
+    clock.lap("singles")
     pairs_tried = []
-    if needs_pairs(scored, F):  # forward selection: the bases refit from the other valleys first
+    if needs_pairs(scored, F):
         bases = pair_bases(scored)
         fits = {s.name: s.fit.theta for s in scored}
         refined = score_candidates([candidate(b, space, m) for b in bases], runs, theta0, baseline=base, log=say,
@@ -205,10 +218,14 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
         scored += score_candidates(pc, runs, theta0, max_nfev=2 * settings.max_nfev, log=say, baseline=base,
                                    starts={n: [fits[effects_of(n)[0]]] for n in names})
         pairs_tried = names
-    lap("pairs")
-    # localise: residuals of the baseline refit, fingerprints
-    runs_b = with_transient(c0, base.fit.theta, runs)
-    res = residual_map(c0, base.fit.theta, runs_b)
+    clock.lap("pairs")
+    return scored, pairs_tried
+
+
+def _localise(c0, base, runs, mrows, m, sdb):
+    """Residuals of the baseline refit, the fingerprints, each effect's verdicts and what points
+    outside the library."""
+    res = residual_map(c0, base.fit.theta, with_transient(c0, base.fit.theta, runs))
     usable = mrows.loc[[r.row["run_id"] for r in runs]].reset_index()
     jb = dict(zip(PARAMS, base.fit.theta))
     model_fz = {}
@@ -219,61 +236,38 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     scatter_f = float(np.sqrt(np.mean(sf**2))) if len(sf) else 1e-4
     fp = fingerprints(res, usable, model_fz, jb, max(scatter_f, 2e-5), m)
     ver = verdicts(fp, float(sdb[-1]), max(scatter_f, 2e-5))
-    outside = outside_library(fp)
-    decision = decide(scored, outside, floor=F)
-    effect, confidence, ranked = decision.effect, decision.confidence, decision.ranked
-    cand_out = [_candidate_json(s, space, m, ver) for s in ranked]
-    # act: the named model, recalibrated and revalidated in the time domain
-    named = next((s for s in ranked if s.name == effect), None)
-    final = named if named is not None else base
+    return res, fp, ver, outside_library(fp)
+
+
+def _recalibrated(assembly, final, space, m, runs, joint_starts, settings, say):
+    """The named (or baseline) model refit from the calibration's other valleys too, then recalibrated
+    (`recalibrate`: GA over the grown space, polish, emcee). Returns the scored candidate with the
+    recalibrated fit, the candidate, the recalibration and the number of seeding fits."""
     cf = candidate(final.name, space, m)
     fits = [final.fit]
-    for th in joint_starts:  # the final model from the GA's other valleys too
+    for th in joint_starts:
         start = _with_joint(cf, final.fit.theta, th)
         alt = fit_candidate(cf, runs, start, starts=1, max_nfev=2 * settings.max_nfev, refresh=1)
         say(f"{assembly}: {final.name} refit from Fs = {cf.grown.column(start, 'Fs'):.3g} lbf: E {alt.E:.2f}")
         fits.append(alt)
     rec = recalibrate(cf, runs, fits, seed=settings.seed, generations=settings.ga_generations,
                       steps=settings.posterior_steps, max_nfev=2 * settings.max_nfev)
-    lap("recalibrate")
     say(f"{assembly}: {final.name} recalibrated: GA best E {rec.ga_best_E:.2f} ({rec.ga_generations} generations), "
         f"polished E {rec.fit.E:.2f}; emcee {rec.steps} steps, tau {rec.tau_max:.0f}")
-    final = type(final)(final.name, rec.fit, final.score, final.held_out, final.seconds)
-    models_after = {r["run_id"]: model_at(cf, final.fit.theta, r) for r in rows}
-    say(f"{assembly}: decision {effect} ({confidence}); revalidating with the time simulation")
-    v_after = validate_runs([models_after[r["run_id"]] for r in rows], records, rows, settings=validate_settings,
-                            envelopes_kw=envelopes_kw, modal_kw=modal_kw, executor=executor)
-    if metric_before is None:
-        v_before = validate_runs([model_from_best(best) for _ in rows], records, rows, settings=validate_settings,
-                                 envelopes_kw=envelopes_kw, modal_kw=modal_kw, executor=executor)
-        metric_before = float(v_before.error["E"])
-    metric_after = float(v_after.error["E"])
-    lap("validate_after")
-    effect, confidence, time_note = confirm(effect, confidence, float(metric_before), metric_after)
+    return type(final)(final.name, rec.fit, final.score, final.held_out, final.seconds), cf, rec, len(fits)
+
+
+def _recalibrated_json(final, cf, rec, n_fits) -> dict:
+    """diagnosis.json's "recalibrated": the model, its joint and effect parameters with 90% intervals."""
     after = cf.grown.named(final.fit.theta)
-    joint_after = {p: {"value": after[p], "interval_90": rec.interval(p)} for p in PARAMS}
-    diagnosis = {
-        "assembly": assembly, "effect": effect, "effects": list(effects_of(effect)) if effect not in (
-            "none", "unexplained") else [], "confidence": confidence, "rule": decision.rule,
-        "rule_applied": [*decision.applied, *([CLAUSES[time_note]] if time_note else [])],
-        "outside_library": outside,
-        "fast_model_floor": floor, "time_domain_check": time_note,
-        "baseline": {"held_out_score": base.score, "E_fit": base.fit.E, "held_out_E_per_level": base.held_out,
-                     "joint_parameters": c0.grown.named(base.fit.theta, PARAMS)},
-        "candidates": cand_out, "pairs_tried": pairs_tried, "fingerprints": fp,
-        "metric_before": float(metric_before), "metric_after": metric_after,
-        "metric_change": metric_after / metric_before - 1.0 if metric_before else None,
-        "recalibrated": {"model": final.name, "joint_parameters": joint_after, "E_fit": final.fit.E,
-                         "effect_parameters": {p.name: {"value": after[p.name], "unit": p.unit,
-                                                        "interval_90": rec.interval(p.name)}
-                                               for p in cf.effect_params},
-                         "method": (f"DEAP GA ({rec.ga_generations} generations, best E {rec.ga_best_E:.3g}) seeded "
-                                    f"with {len(fits)} least-squares fits, polished; emcee {rec.steps} steps x {rec.walkers} "
-                                    f"walkers, max tau {rec.tau_max:.0f} steps"
-                                    + ("" if rec.converged else " (short of 50 tau: intervals approximate)")
-                                    + "; intervals are the 5-95% posterior quantiles"),
-                         "posterior_converged": rec.converged},
-        "calibration_joint_parameters": dict(zip(PARAMS, map(float, theta0))),
-        "words_after": v_after.words, "seconds": time.perf_counter() - t_start, "seconds_per_step": clock,
-    }
-    return {"diagnosis": diagnosis, "residuals": res, "validation_after": v_after}
+    return {"model": final.name,
+            "joint_parameters": {p: {"value": after[p], "interval_90": rec.interval(p)} for p in PARAMS},
+            "E_fit": final.fit.E,
+            "effect_parameters": {p.name: {"value": after[p.name], "unit": p.unit,
+                                           "interval_90": rec.interval(p.name)} for p in cf.effect_params},
+            "method": (f"DEAP GA ({rec.ga_generations} generations, best E {rec.ga_best_E:.3g}) seeded "
+                       f"with {n_fits} least-squares fits, polished; emcee {rec.steps} steps x {rec.walkers} "
+                       f"walkers, max tau {rec.tau_max:.0f} steps"
+                       + ("" if rec.converged else " (short of 50 tau: intervals approximate)")
+                       + "; intervals are the 5-95% posterior quantiles"),
+            "posterior_converged": rec.converged}

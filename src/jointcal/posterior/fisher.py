@@ -100,7 +100,6 @@ def fisher(theta: ArrayLike, sigma: ArrayLike, q: ArrayLike, f: ArrayLike, zeta:
         return np.concatenate([fm, zm], axis=1)
 
     _, jac = unit_jacobian(fn, space.to_unit(theta), space, h=h)
-    n = q.shape[1]
     scale = np.concatenate([1.0 / (f * sigma[:, :1]), 1.0 / (zeta * sigma[:, 1:])], axis=1)  # (P, 2N)
     G = np.where(np.isfinite(jac), jac, 0.0) * scale[:, :, None]
     return np.einsum("pki,pkj->pij", G, G)

@@ -165,16 +165,7 @@ def _check_shapes(s: dict, where: str) -> None:
 
 def load_spec(spec: dict | str | os.PathLike) -> dict:
     """Complete a spec with the defaults and validate it (one clear error per problem)."""
-    where = "spec"
-    root = Path.cwd()
-    if not isinstance(spec, dict):
-        path = Path(spec)
-        where, root = str(path), path.parent
-        if not path.is_file():
-            raise ValueError(f"{path}: spec file not found; give the path of a YAML or JSON truth spec.")
-        spec = _parse(path)
-        if not isinstance(spec, dict):
-            raise ValueError(f"{path}: a spec must be a mapping of keys (seed, assemblies, ...).")
+    spec, where, root = _read_spec(spec)
     unknown = set(spec) - set(DEFAULT_SPEC) - {"seed", "effect_file"}
     if unknown:
         raise ValueError(f"{where}: unknown key(s) {sorted(unknown)}; valid keys are {sorted(DEFAULT_SPEC)} + seed.")
@@ -187,6 +178,29 @@ def load_spec(spec: dict | str | os.PathLike) -> dict:
             raise ValueError(f"{where}: effect_file {ef} not found; fix the path (relative to the spec).")
         s["effect"] = _parse(ef)
     _check_shapes(s, where)
+    _check_effects(s, where)
+    _coerce(s, where)
+    effect_defaults(s["effect"]["name"], s["effect"]["params"])
+    _check_values(s, where)
+    _check_rig(s, where)
+    return s
+
+
+def _read_spec(spec) -> tuple[dict, str, Path]:
+    """The spec mapping, where it came from (for messages) and the folder its relative paths start at."""
+    if isinstance(spec, dict):
+        return spec, "spec", Path.cwd()
+    path = Path(spec)
+    if not path.is_file():
+        raise ValueError(f"{path}: spec file not found; give the path of a YAML or JSON truth spec.")
+    parsed = _parse(path)
+    if not isinstance(parsed, dict):
+        raise ValueError(f"{path}: a spec must be a mapping of keys (seed, assemblies, ...).")
+    return parsed, str(path), path.parent
+
+
+def _check_effects(s: dict, where: str) -> None:
+    """The hidden effect as {name, params}, and a second one (effect.also) checked and completed."""
     also = s["effect"].get("also")  # a second hidden effect at the same time: {name, params}
     s["effect"] = {"name": s["effect"].get("name", "none"), "params": s["effect"].get("params") or {}}
     if also:
@@ -196,8 +210,10 @@ def load_spec(spec: dict | str | os.PathLike) -> dict:
         effect_defaults(also["name"], s["effect"]["also"]["params"])
         if also["name"] == s["effect"]["name"]:
             raise ValueError(f"{where}: effect.also names {also['name']!r} again; hide a different second effect.")
-    _coerce(s, where)
-    effect_defaults(s["effect"]["name"], s["effect"]["params"])
+
+
+def _check_values(s: dict, where: str) -> None:
+    """File format, sweep band against the sample rate, assemblies and the measurement chain."""
     if s["file_format"] not in ("csv", "csv.gz", "mat"):
         raise ValueError(f"{where}: file_format must be csv, csv.gz or mat, got {s['file_format']!r}.")
     sw = s["sweep"]
@@ -212,6 +228,13 @@ def load_spec(spec: dict | str | os.PathLike) -> dict:
         if missing or 0 < len(joint) < len(JOINT_KEYS):
             raise ValueError(f"{where}: assembly {name!r} lacks {sorted(missing | (set(JOINT_KEYS) - set(joint)))} "
                              "(give k, zeta_v and all of Fs, KT, chi, beta, or none of these four for a linear structure).")
+    m = s["measurement"]
+    if not (0 <= m["noise_fraction"] < 1 and m["bits"] >= 8 and int(m["oversample"]) >= 1):
+        raise ValueError(f"{where}: measurement needs 0 <= noise_fraction < 1, bits >= 8, oversample >= 1; got {m}.")
+
+
+def _check_rig(s: dict, where: str) -> None:
+    """The rig (reference, shaker, second mode) and the series' levels in the reference's unit."""
     rig = s["rig"]
     if set(rig) - {"reference", "shaker", "second_mode"} or rig.get("reference") not in RIG_LEVEL:
         raise ValueError(f"{where}: rig must be {{reference: base | force | voltage, shaker: {{...}}, "
@@ -235,7 +258,3 @@ def load_spec(spec: dict | str | os.PathLike) -> dict:
     for item in s["series"]:
         if not (item.get(level, 0) > 0) or any(d not in ("up", "down") for d in item.get("directions", ["up"])):
             raise ValueError(f"{where}: series item {item} needs {level} > 0 and directions among up/down.")
-    m = s["measurement"]
-    if not (0 <= m["noise_fraction"] < 1 and m["bits"] >= 8 and int(m["oversample"]) >= 1):
-        raise ValueError(f"{where}: measurement needs 0 <= noise_fraction < 1, bits >= 8, oversample >= 1; got {m}.")
-    return s

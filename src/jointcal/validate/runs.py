@@ -37,91 +37,10 @@ from ..measure.modal import measure_run
 from ..measure.peaks import FULL_DRIVE, transmissibility
 from ..measure.peaks import full_drive as full_drive_frames
 from ..models import MinistackModel, simulate
-from ..units import G
+from .drive import clean_base, drive_gain, model_input, reference_column, simulate_record
 
 __all__ = ["clean_base", "reference_column", "drive_gain", "model_input", "simulate_record", "band_frames",
            "compare_run", "measure_pair", "time_envelopes", "draw_transmissibility"]
-
-
-def reference_column(record: pd.DataFrame) -> str:
-    """The record's reference channel: base_accel_g, force_lbf or drive_V."""
-    cols = [c for c in REFERENCE.values() if c in record.columns]
-    if len(cols) != 1:
-        raise ValueError(f"a run record needs exactly one reference channel ({', '.join(REFERENCE.values())}); "
-                         f"it has {', '.join(map(str, record.columns))}.")
-    return cols[0]
-
-
-def clean_base(record: pd.DataFrame, column: str = "base_accel_g") -> NDArray[np.float64]:
-    """A reference channel as the model's input: NaN/inf bridged linearly, median removed, shape (N,)."""
-    x = record[column].to_numpy(dtype=float).copy()
-    ok = np.isfinite(x)
-    if not ok.any():
-        raise ValueError(f"the {column} channel holds no finite sample; the run cannot drive a simulation.")
-    if not ok.all():
-        i = np.arange(x.size)
-        x[~ok] = np.interp(i[~ok], i[ok], x[ok])
-    return x - np.median(x)
-
-
-def drive_gain(modal: pd.DataFrame) -> tuple[complex, complex, float] | None:
-    """The campaign's modal constant, (A_c, A' per rad/s, w_c rad/s): the median over the swept-mode fits.
-
-    Each run's A (at its f_res_hz) is moved to the common w_c (the median resonance) along its own
-    slope; the median of the real and imaginary parts of A_c and A'. None without sweep fits.
-    """
-    need = ("modal_constant_re", "modal_constant_im", "modal_slope_re", "modal_slope_im", "f_res_hz")
-    if not all(c in modal.columns for c in need):
-        return None
-    ok = modal[list(need)].apply(pd.to_numeric, errors="coerce").dropna()
-    if ok.empty:
-        return None
-    w = 2 * np.pi * ok["f_res_hz"].to_numpy()
-    wc = float(np.median(w))
-    a = ok["modal_constant_re"].to_numpy() + 1j * ok["modal_constant_im"].to_numpy()
-    da = ok["modal_slope_re"].to_numpy() + 1j * ok["modal_slope_im"].to_numpy()
-    ac = a + da * (wc - w)
-    med = lambda z: complex(np.median(z.real), np.median(z.imag))  # noqa: E731
-    return med(ac), med(da), wc
-
-
-def _through_gain(r: NDArray, fs: float, gain: tuple[complex, complex, float]) -> NDArray:
-    """A(w) applied line by line to a real record (positive frequencies; the negative ones conjugate)."""
-    ac, da, wc = gain
-    n = 1 << int(np.ceil(np.log2(2 * r.size)))
-    w = 2 * np.pi * np.fft.rfftfreq(n, 1.0 / fs)
-    a = ac + da * np.clip(w - wc, -0.45 * wc, 0.45 * wc)
-    return np.fft.irfft(np.fft.rfft(r, n) * a, n)[:r.size]
-
-
-def model_input(record: pd.DataFrame, row: Mapping) -> tuple[NDArray[np.float64], str]:
-    """The model's input as a base acceleration (g), and the reference column (see the module docstring)."""
-    col = reference_column(record)
-    x = clean_base(record, col)
-    if col == REFERENCE["base"]:
-        return x, col
-    gain = row.get("drive_gain")
-    if gain is None:
-        raise ValueError(f"run {row.get('run_id', '?')}: a {col} reference drives the model through the mode's "
-                         "modal constant, and the modal stage found none (no swept-mode fit in the campaign); "
-                         "the run cannot be simulated.")
-    return -_through_gain(x, float(row["sample_rate_hz"]), gain) / G, col
-
-
-def simulate_record(model: MinistackModel, record: pd.DataFrame, row: Mapping) -> pd.DataFrame:
-    """The record the model would give: measured time and reference columns, simulated response (g).
-
-    Samples where the measured reference is not finite are NaN in the simulated response too,
-    so the same frames are left out of both envelopes.
-    """
-    a_b, col = model_input(record, row)
-    y = simulate(model, a_b, float(row["sample_rate_hz"])).response_g
-    if col != REFERENCE["base"]:
-        y = y - a_b  # a fixed base forced by -m a_b: the mass's acceleration is the relative one
-    y[~np.isfinite(record[col].to_numpy(dtype=float))] = np.nan
-    out = record[["time_s", col]].copy()
-    out["response_accel_g"] = y
-    return out
 
 
 HEAD = ("run_id", "assembly", "sequence", *LEVEL.values(), "direction")
