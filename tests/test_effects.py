@@ -137,7 +137,8 @@ def test_toy_effect_runs_through_synth_and_diagnose(toy, tmp_path):
     recalibration)."""
     from jointcal.discrepancy import DiscrepancySettings, diagnose
     from jointcal.io import read_manifest, read_run, write_csv_atomic
-    from jointcal.modal import measure_run, scatter
+    from jointcal.measure.modal import measure_run
+    from jointcal.measure.scatter import scatter
     from jointcal.synth import generate
 
     truth = dict(Fs=280.0, KT=1.1e6, chi=-0.6, beta=0.01, k=7.0e5, zeta_v=0.002)

@@ -27,7 +27,7 @@ SPACE = CalibrateSettings().space
 def _campaign(folder: Path) -> list:
     """Envelopes of a virtual-lab campaign (other joint than the example, 10 kHz, 400 Hz/s) with a hidden gain."""
     from jointcal.io import read_manifest, read_run
-    from jointcal.modal import measure_run
+    from jointcal.measure.modal import measure_run
     from jointcal.synth import generate
 
     spec = {"seed": 11, "sample_rate_hz": 10000.0,
