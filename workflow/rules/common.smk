@@ -1,14 +1,15 @@
-# Shared paths and input functions of the jointcal workflow (logic lives in src/jointcal/).
-import csv
-import os
+# Shared names, paths and input functions of the jointcal workflow (logic lives in src/jointcal/); every
+# stage's file uses them, so the stage files may be included in any order after this one.
+import re
+import subprocess
 import sys
-import warnings
+import time
 from pathlib import Path
 
 from snakemake.utils import validate
 
-from jointcal._workflow import config_problem, stage_hash
-from jointcal.io import CampaignError, CampaignWarning, read_manifest, write_bytes_atomic
+from jointcal._workflow import campaign_index, config_problem, pending_outputs, stage_hash
+from jointcal.io import write_bytes_atomic
 
 # Config: an unknown key (a typo) is one line naming the nearest valid key, before the schema's own
 # validation (whose message is a dump of the schema); nested --config values given as text are converted.
@@ -39,38 +40,38 @@ if not MANIFEST.is_file():
         "with --config raw_data=PATH/TO/CAMPAIGN."
     )
 
-
-def _manifest_rows():
-    """The manifest's rows as text, read leniently at parse time (a workflow of the later stages only,
-    started from their tables, may hold a manifest of run_id, assembly and file alone)."""
-    with open(MANIFEST, newline="", encoding="utf-8-sig") as fh:
-        return [{(k or "").strip(): (v or "").strip() for k, v in r.items()} for r in csv.DictReader(fh)]
-
-
-RUN_FILES = {r["run_id"]: str(RAW_DATA / r.get("file", "")) for r in _manifest_rows() if r.get("run_id")}
+# The campaign, read once with jointcal.io.read_manifest (jointcal._workflow.campaign_index): a manifest
+# that fails its checks still names the jobs, and the rules that read raw records stop on its error.
+CAMPAIGN = campaign_index(MANIFEST)
+RUN_FILES = CAMPAIGN.run_files
 RUN_IDS = list(RUN_FILES)
-ASSEMBLIES = list(dict.fromkeys(r["assembly"] for r in _manifest_rows() if r.get("assembly")))
-# the campaign's reference kind from the manifest's level column (base unless level_lbf / level_V)
-EXCITATION = next((k for k, col in (("force", "level_lbf"), ("voltage", "level_V"))
-                   if _manifest_rows() and col in _manifest_rows()[0]), "base")
-_CHECKED = []
+ASSEMBLIES = CAMPAIGN.assemblies
+ASSEMBLY_RE = "|".join(re.escape(a) for a in ASSEMBLIES) or "no-assembly"
+EXCITATION = CAMPAIGN.excitation  # base, force or voltage, from the manifest's level column
+
+# Each stage's folder under RESULTS (stages in the order data flows).
+INGEST = RESULTS / "ingest"
+ENVELOPES = RESULTS / "envelopes"
+MODAL = RESULTS / "modal"
+CALIBRATION = RESULTS / "calibration"
+POSTERIOR = RESULTS / "posterior"
+VALIDATION = RESULTS / "validation"
+DISCREPANCY = RESULTS / "discrepancy"
+DESIGN = RESULTS / "design"
+FIGURES = RESULTS / "figures"
+REPORT = RESULTS / "report"  # the summary page and the run-generated captions
 
 
 def checked_campaign():
-    """Read and check the manifest once, with jointcal.io.read_manifest, in the input function of every rule
-    that reads raw records: a Windows path, a listed file that is missing or any other manifest problem
-    stops the workflow there with the one-sentence message on stderr and in the ingest log, before
-    Snakemake looks for the records (its MissingInputException names no fix). Notes on the manifest
-    (empty trailing rows) are left to the ingest stage's log."""
-    if not _CHECKED:
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", CampaignWarning)
-                _CHECKED.append(read_manifest(MANIFEST))
-        except CampaignError as exc:
-            write_bytes_atomic(f"jointcal: {exc}\n".encode(), RESULTS / "logs" / "ingest.log")
-            sys.exit(f"jointcal: {exc}")
-    return _CHECKED[0]
+    """Stop on the manifest's problem, if it has one, in the input function of every rule that reads raw
+    records: a Windows path, a listed file that is missing or any other manifest problem stops the workflow
+    there with the one-sentence message on stderr and in the ingest log, before Snakemake looks for the
+    records (its MissingInputException names no fix). Notes on the manifest (empty trailing rows) are left
+    to the ingest stage's log."""
+    if CAMPAIGN.problem:
+        write_bytes_atomic(f"jointcal: {CAMPAIGN.problem}\n".encode(), RESULTS / "logs" / "ingest.log")
+        sys.exit(f"jointcal: {CAMPAIGN.problem}")
+    return CAMPAIGN
 
 
 def campaign_files(wildcards):
@@ -93,7 +94,7 @@ def run_record(wildcards):
 
 def ingest_table(wildcards):
     """The ingest stage's runs.csv when the workflow has that stage (one of calibrate + posterior only has not)."""
-    return [str(RESULTS / "ingest" / "runs.csv")] if has_rule("ingest") else []
+    return [str(INGEST / "runs.csv")] if has_rule("ingest") else []
 
 
 def has_rule(name):
@@ -111,35 +112,39 @@ def verdict_inputs(wildcards):
     """The later stages' outputs the verdict reads, for the stages this workflow has."""
     out = {}
     if has_rule("validate_assembly"):
-        out["validation"] = [str(RESULTS / "validation" / a / "summary.json") for a in ASSEMBLIES]
+        out["validation"] = [str(VALIDATION / a / "summary.json") for a in ASSEMBLIES]
     if has_rule("discrepancy_assembly") and EXCITATION == "base":
-        out["diagnosis"] = [str(RESULTS / "discrepancy" / a / "diagnosis.json") for a in ASSEMBLIES]
+        out["diagnosis"] = [str(DISCREPANCY / a / "diagnosis.json") for a in ASSEMBLIES]
     if has_rule("design_assembly"):
-        out["design"] = [str(RESULTS / "design" / a / "next_test.json") for a in ASSEMBLIES]
+        out["design"] = [str(DESIGN / a / "next_test.json") for a in ASSEMBLIES]
     return out
 
 
 def assembly_records(wildcards):
     """The raw records of one assembly's runs, once the manifest is checked."""
-    table = checked_campaign()
-    return [RUN_FILES[rid] for rid, asm in zip(table["run_id"], table["assembly"]) if asm == wildcards.assembly]
+    return checked_campaign().assembly_files(wildcards.assembly)
+
+
+STARTED = time.time()  # when this run parsed the workflow: outputs written since are this run's
 
 
 def remove_stale_outputs():
-    """After a failed run, remove the outputs of every job the run had scheduled and did not finish.
+    """After a failed run, remove the outputs the same command still plans to remake and this run did not.
 
     Snakemake deletes the outputs of the job that failed; those of the previous run further down
-    (calibration, posterior, figures, table) would stay and look current. A job scheduled to rerun
-    has outdated outputs (its inputs, code hash or params changed, or an upstream job reran), so
-    they go; finished jobs, logs, benchmarks and the GA/chain checkpoints stay (a rerun resumes).
+    (calibration, posterior, figures, table) would stay and look current. Snakemake's own summary of the
+    same command (``--summary``: the plan for each output file) names the outputs whose jobs are still to
+    run (their inputs, code hash or params changed, or an upstream job reran or failed), so those
+    written before this run go; finished jobs, logs, benchmarks and the GA/chain checkpoints stay (a
+    rerun resumes).
     """
-    try:  # Snakemake 9's DAG (workflow.dag, DAG.needrun_jobs)
-        jobs = list(workflow.dag.needrun_jobs(exclude_finished=True))
-    except AttributeError:
-        print("jointcal: the run failed; outputs of jobs that did not run may be out of date "
-              "(this Snakemake version does not show which)", file=sys.stderr)
+    cli = Path(sys.argv[0])
+    if not (cli.name == "snakemake" or cli.parent.name == "snakemake"):  # run through an API: no command
+        print("jointcal: the run failed; outputs of jobs that did not run may be out of date", file=sys.stderr)
         return
-    stale = [Path(f) for job in jobs for f in job.output if os.path.isfile(f)]
+    summary = subprocess.run([sys.executable, "-m", "snakemake", *sys.argv[1:], "--summary", "--nolock"],
+                             capture_output=True, text=True)
+    stale = pending_outputs(summary.stdout, before=STARTED)
     for f in stale:
         f.unlink(missing_ok=True)
     if stale:

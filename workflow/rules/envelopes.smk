@@ -3,10 +3,10 @@
 rule envelopes_run:
     input:
         record=run_record,
-        runs=RESULTS / "ingest" / "runs.csv",
+        runs=INGEST / "runs.csv",
     output:
-        env=RESULTS / "envelopes" / "{run_id}.csv",
-        meta=RESULTS / "envelopes" / "{run_id}.json",
+        env=ENVELOPES / "{run_id}.csv",
+        meta=ENVELOPES / "{run_id}.json",
     params:
         code=source_hash("envelopes.py"),
         envelopes=config["envelopes"],
@@ -20,4 +20,4 @@ rule envelopes_run:
 
 rule envelopes:
     input:
-        expand(RESULTS / "envelopes" / "{run_id}.csv", run_id=RUN_IDS),
+        expand(ENVELOPES / "{run_id}.csv", run_id=RUN_IDS),

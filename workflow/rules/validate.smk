@@ -1,14 +1,12 @@
 # Stage validate: the calibrated model driven by each run's measured base record, through the
 # same envelopes and modal code (jointcal.validate); Fig. 3.11.
-# Include after posterior.smk (uses ASSEMBLY_RE and POSTERIOR).
-VALIDATION = RESULTS / "validation"
 
 
 rule validate_assembly:
     input:
-        runs=RESULTS / "ingest" / "runs.csv",
-        modal=RESULTS / "modal" / "modal_properties.csv",
-        best=RESULTS / "calibration" / "{assembly}" / "ga_best.json",
+        runs=INGEST / "runs.csv",
+        modal=MODAL / "modal_properties.csv",
+        best=CALIBRATION / "{assembly}" / "ga_best.json",
         chain=POSTERIOR / "{assembly}" / "chain.npz",
         records=assembly_records,
     output:
@@ -37,7 +35,7 @@ rule validate_figures:
         summary=expand(VALIDATION / "{assembly}" / "summary.json", assembly=ASSEMBLIES),
         envelopes=expand(VALIDATION / "{assembly}" / "envelopes", assembly=ASSEMBLIES),
     output:
-        figure=report(RESULTS / "figures" / "fig3_11_validation.png", caption="../report/fig3_11_validation.rst",
+        figure=report(FIGURES / "fig3_11_validation.png", caption="../report/fig3_11_validation.rst",
                       category="4. Validation"),
     params:
         code=source_hash("validate_figures.py"),
