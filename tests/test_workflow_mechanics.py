@@ -185,7 +185,7 @@ def test_discrepancy_target_runs_only_that_stage_and_what_it_needs(touched, tmp_
         module.write_text(original)
     fresh = ["--config", f"raw_data={SMALL_CAMPAIGN}", f"results={tmp_path / 'fresh'}"]
     jobs = set(_jobs(_snakemake(work, "-n", "discrepancy", *fresh)))
-    assert {"ingest", "envelopes_run", "calibrate_assembly", "validate_assembly", "discrepancy_assembly",
+    assert {"ingest", "envelopes_runs", "calibrate_assembly", "validate_assembly", "discrepancy_assembly",
             "discrepancy_table"} <= jobs
     assert not jobs & {"modal_figures", "calibration_figures", "posterior_corner", "validate_figures",
                        "report_summary"}, jobs
@@ -207,7 +207,7 @@ def test_typo_in_config_is_one_line_before_any_schema_dump(touched):
 
 
 @pytest.mark.slow
-def test_slurm_profile_dry_run_has_one_job_per_run_and_per_assembly(tmp_path):
+def test_slurm_profile_dry_run_has_one_job_per_assembly(tmp_path):
     """On the example campaign (24 runs, 2 assemblies), with the profile's per-rule resources."""
     work = tmp_path / "wf"
     work.mkdir()
@@ -217,7 +217,7 @@ def test_slurm_profile_dry_run_has_one_job_per_run_and_per_assembly(tmp_path):
     res = _snakemake(work, "-n", "--workflow-profile", "workflow/profiles/slurm",
                      "--config", f"raw_data={REPO / 'raw_data'}", f"results={tmp_path / 'results'}")
     assert "workflow/profiles/slurm" in res.stderr + res.stdout
-    assert _jobs(res) == {"ingest": 1, "envelopes_run": 24, "modal_properties": 1, "modal_figures": 1,
+    assert _jobs(res) == {"ingest": 1, "envelopes_runs": 1, "modal_properties": 1, "modal_figures": 1,
                           "calibrate_assembly": 2, "calibration_figures": 2, "posterior_assembly": 2,
                           "posterior_corner": 2, "posterior_report": 1, "report_summary": 1,
                           "validate_assembly": 2, "validate_figures": 1, "discrepancy_assembly": 2,
@@ -225,7 +225,8 @@ def test_slurm_profile_dry_run_has_one_job_per_run_and_per_assembly(tmp_path):
     blocks = re.findall(r"rule (\w+):\n(?:    .*\n)*?    resources: (.*)", res.stdout + res.stderr)
     resources = {rule: dict(kv.split("=", 1) for kv in line.split(", ")) for rule, line in blocks}
     assert resources["calibrate_assembly"]["runtime"] == "30" and resources["posterior_assembly"]["runtime"] == "60"
-    assert resources["envelopes_run"]["runtime"] == "5" and resources["ingest"]["cpus_per_task"] == "1"
+    assert resources["envelopes_runs"]["runtime"] == "15" and resources["ingest"]["cpus_per_task"] == "1"
+    assert resources["envelopes_runs"]["cpus_per_task"] == "2" == resources["validate_assembly"]["cpus_per_task"]
 
 
 @pytest.mark.slow

@@ -18,7 +18,7 @@ rule calibrate_assembly:
         assembly=ASSEMBLY_RE,
     threads: 1
     benchmark:
-        RESULTS / "benchmarks" / "calibrate" / "{assembly}.tsv"
+        RESULTS / "benchmarks" / "calibrate_assembly" / "{assembly}.tsv"
     log:
         RESULTS / "logs" / "calibrate" / "{assembly}.log",
     script:

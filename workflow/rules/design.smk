@@ -28,7 +28,7 @@ rule design_assembly:
         assembly=ASSEMBLY_RE,
     threads: 1
     benchmark:
-        RESULTS / "benchmarks" / "design_{assembly}.tsv"
+        RESULTS / "benchmarks" / "design_assembly" / "{assembly}.tsv"
     log:
         RESULTS / "logs" / "design" / "{assembly}.log",
     script:

@@ -36,7 +36,7 @@ rule discrepancy_assembly:
         assembly=ASSEMBLY_RE,
     threads: 2
     benchmark:
-        RESULTS / "benchmarks" / "discrepancy_{assembly}.tsv"
+        RESULTS / "benchmarks" / "discrepancy_assembly" / "{assembly}.tsv"
     log:
         RESULTS / "logs" / "discrepancy" / "{assembly}.log",
     script:

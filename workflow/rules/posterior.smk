@@ -22,7 +22,7 @@ rule posterior_assembly:
         assembly=ASSEMBLY_RE,
     threads: 1
     benchmark:
-        RESULTS / "benchmarks" / "posterior" / "{assembly}.tsv"
+        RESULTS / "benchmarks" / "posterior_assembly" / "{assembly}.tsv"
     log:
         RESULTS / "logs" / "posterior" / "{assembly}.log",
     script:

@@ -22,7 +22,7 @@ rule validate_assembly:
         assembly=ASSEMBLY_RE,
     threads: 2
     benchmark:
-        RESULTS / "benchmarks" / "validate_{assembly}.tsv"
+        RESULTS / "benchmarks" / "validate_assembly" / "{assembly}.tsv"
     log:
         RESULTS / "logs" / "validate" / "{assembly}.log",
     script:
