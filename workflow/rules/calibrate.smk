@@ -17,6 +17,7 @@ rule calibrate_assembly:
     wildcard_constraints:
         assembly=ASSEMBLY_RE,
     threads: 1
+    priority: 10  # on the longest chain of jobs (figures and tables fill the gaps)
     benchmark:
         RESULTS / "benchmarks" / "calibrate_assembly" / "{assembly}.tsv"
     log:

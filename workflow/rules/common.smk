@@ -6,6 +6,7 @@ import sys
 import time
 from pathlib import Path
 
+from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
 from jointcal._workflow import campaign_index, config_problem, pending_outputs, stage_hash
@@ -62,6 +63,17 @@ FIGURES = RESULTS / "figures"
 REPORT = RESULTS / "report"  # the summary page and the run-generated captions
 
 
+def pool_threads(wildcards):
+    """Threads of a per-assembly job that spreads its runs over a process pool (validate, discrepancy): the
+    cores shared among the assemblies, so the assemblies' jobs run side by side (most of such a job is one
+    process; its pool serves part of it), and all of them for a campaign of one assembly."""
+    try:
+        cores = int(workflow.cores)
+    except (WorkflowError, TypeError, ValueError):  # no --cores (a dry run or --lint)
+        return 1
+    return max(1, min(cores, 64) // max(1, len(ASSEMBLIES)))
+
+
 def checked_campaign():
     """Stop on the manifest's problem, if it has one, in the input function of every rule that reads raw
     records: a Windows path, a listed file that is missing or any other manifest problem stops the workflow
@@ -99,8 +111,6 @@ def ingest_table(wildcards):
 
 def has_rule(name):
     """Whether this workflow defines rule `name` (called when the DAG is built, after every include)."""
-    from snakemake.exceptions import WorkflowError
-
     try:
         getattr(rules, name)
     except (WorkflowError, AttributeError):

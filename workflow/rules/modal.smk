@@ -13,6 +13,7 @@ rule modal_properties:
     params:
         code=source_hash("modal.py"),
         modal=config["modal"],
+    priority: 10  # on the longest chain of jobs (figures and tables fill the gaps)
     benchmark:
         RESULTS / "benchmarks" / "modal_properties.tsv"
     log:

@@ -21,6 +21,7 @@ rule posterior_assembly:
     wildcard_constraints:
         assembly=ASSEMBLY_RE,
     threads: 1
+    priority: 10  # on the longest chain of jobs (figures and tables fill the gaps)
     benchmark:
         RESULTS / "benchmarks" / "posterior_assembly" / "{assembly}.tsv"
     log:

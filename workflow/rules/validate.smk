@@ -20,7 +20,8 @@ rule validate_assembly:
         modal=config["modal"],
     wildcard_constraints:
         assembly=ASSEMBLY_RE,
-    threads: 2
+    threads: pool_threads
+    priority: 10  # on the longest chain of jobs (figures and tables fill the gaps)
     benchmark:
         RESULTS / "benchmarks" / "validate_assembly" / "{assembly}.tsv"
     log:
