@@ -148,6 +148,10 @@ def remove_stale_outputs():
     written before this run go; finished jobs, logs, benchmarks and the GA/chain checkpoints stay (a
     rerun resumes).
     """
+    kept = {"logs", "benchmarks", "checkpoints"}  # never outputs of a job
+    if not any(f.is_file() and f.stat().st_mtime < STARTED for f in RESULTS.rglob("*")
+               if not kept & set(f.relative_to(RESULTS).parts[:1])):
+        return  # nothing from before this run that could be out of date (e.g. a first run that failed)
     cli = Path(sys.argv[0])
     if not (cli.name == "snakemake" or cli.parent.name == "snakemake"):  # run through an API: no command
         print("jointcal: the run failed; outputs of jobs that did not run may be out of date", file=sys.stderr)
