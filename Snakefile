@@ -37,13 +37,13 @@ include: "workflow/rules/posterior.smk"
 include: "workflow/rules/validate.smk"
 include: "workflow/rules/discrepancy.smk"
 include: "workflow/rules/design.smk"
-include: "workflow/rules/summary.smk"  # last: reads every stage's outputs
+include: "workflow/rules/summary.smk"
 
 
 rule all:
     default_target: True
     input:
-        RESULTS / "ingest" / "runs.csv",
+        INGEST / "runs.csv",
         rules.modal.input,
         rules.calibrate.input,
         rules.posterior.input,

@@ -1,14 +1,19 @@
-"""Shared fixtures: the committed small campaign and a writable copy of it."""
+"""Shared fixtures: the committed small campaign and a writable copy of it; synthetic campaigns made
+once per session (the exact time simulation of a 24-run campaign takes tens of seconds)."""
 from __future__ import annotations
 
 import shutil
 from pathlib import Path
 
+import pandas as pd
 import pytest
-from _campaign import SMALL_CAMPAIGN, voltage_campaign
+from _campaign import DEFAULT_SPEC, SMALL_CAMPAIGN, voltage_campaign
+from _modal_helpers import modal_table
+
+from jointcal.synth import generate
 
 
-@pytest.fixture
+@pytest.fixture(scope="session")
 def small_campaign() -> Path:
     """The committed valid campaign (read only)."""
     return SMALL_CAMPAIGN
@@ -30,3 +35,20 @@ def voltage_source(tmp_path_factory) -> Path:
 def voltage(tmp_path: Path, voltage_source: Path) -> Path:
     """A writable copy of the synthetic voltage-driven campaign, to break in a test."""
     return Path(shutil.copytree(voltage_source, tmp_path / "voltage"))
+
+
+@pytest.fixture(scope="session")
+def default_campaign_dir(tmp_path_factory) -> Path:
+    """The default generator's campaign (`DEFAULT_SPEC`: the paper's Table 3.1 series for both assemblies
+    with Table 3.2 parameters, 300 Hz/s, 0.3% noise, the DAQ chain; no hidden effect), made once per session
+    (read only). Its truth is ``truth.json`` beside the campaign folder."""
+    tmp = tmp_path_factory.mktemp("default_campaign")
+    generate(DEFAULT_SPEC, tmp / "c", tmp / "truth.json")
+    return tmp / "c"
+
+
+@pytest.fixture(scope="session")
+def default_modal(default_campaign_dir: Path) -> pd.DataFrame:
+    """The modal stage's table of `default_campaign_dir` (every run through `jointcal.modal.measure_run`);
+    a copy per use is the caller's to make before editing it."""
+    return modal_table(default_campaign_dir)

@@ -18,12 +18,10 @@ pytestmark = pytest.mark.slow
 
 
 @pytest.fixture(scope="module")
-def default_campaign(tmp_path_factory):
-    """The default generator (Table 3.1/3.2, 300 Hz/s, 0.3% noise), no hidden effect."""
-    tmp = tmp_path_factory.mktemp("default")
-    generate({"seed": 7}, tmp / "c", tmp / "truth.json")
-    table = modal_table(tmp / "c")
-    return table, against_truth(table, tmp / "truth.json")
+def default_campaign(default_campaign_dir, default_modal):
+    """The default generator (Table 3.1/3.2, 300 Hz/s, 0.3% noise), no hidden effect (made once: conftest.py)."""
+    table = default_modal.copy()
+    return table, against_truth(table, default_campaign_dir.parent / "truth.json")
 
 
 def test_resonance_and_damping_match_truth(default_campaign):

@@ -14,24 +14,20 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from _modal_helpers import modal_table
 from jointcal.calibrate import CalibrateSettings, run_calibration
 from jointcal.io import write_csv_atomic
 from jointcal.measure.scatter import scatter
 from jointcal.models import harmonic_balance
-from jointcal.synth import generate
 
 pytestmark = pytest.mark.slow
 
 PARAMS = ("Fs", "KT", "chi", "beta", "k", "zeta_v")
 
 
-def _measure(tmp: Path, spec: dict):
-    generate(spec, tmp / "campaign", tmp / "truth.json")
-    table = modal_table(tmp / "campaign")
+def _measure(tmp: Path, campaign: Path, table):
     write_csv_atomic(table, tmp / "modal_properties.csv")
     write_csv_atomic(scatter(table), tmp / "scatter.csv")
-    return table, json.loads((tmp / "truth.json").read_text())
+    return table, json.loads((campaign.parent / "truth.json").read_text())
 
 
 def _curve_errors(best: dict, truth: dict, q: np.ndarray):
@@ -46,8 +42,9 @@ def _calibrate(args):
     return run_calibration(modal_csv, asm, out, CalibrateSettings())[0].best
 
 
-def test_default_campaign_calibrates_to_the_truths_curves(tmp_path):
-    table, truth = _measure(tmp_path, {"seed": 31})
+def test_default_campaign_calibrates_to_the_truths_curves(tmp_path, default_campaign_dir, default_modal):
+    """The session's default campaign (conftest.py; its modal table shared with test_modal)."""
+    table, truth = _measure(tmp_path, default_campaign_dir, default_modal)
     jobs = [(tmp_path / "modal_properties.csv", asm, tmp_path / asm) for asm in ("first", "reassembly")]
     with multiprocessing.get_context("fork").Pool(2) as pool:  # the two GA runs are independent
         bests = pool.map(_calibrate, jobs)

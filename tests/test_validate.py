@@ -6,7 +6,6 @@ Oracles: an analytic FRF for a linear model; the truth that generated a syntheti
 from __future__ import annotations
 
 import json
-import re
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
@@ -162,57 +161,3 @@ def test_E_of_the_calibrated_model_is_at_the_noise_floor_and_grows_with_a_hidden
     assert m["f_res_rel_err"].abs().max() < 1e-4 and m["zeta_rel_err"].abs().max() < 2e-3
     assert e_cal <= 1.5 * e_true
     assert v_gain.error["E"] >= 3 * e_cal
-
-
-@pytest.mark.slow
-def test_workflow_validate_stage_reruns_only_itself_on_a_config_edit(tmp_path, small_campaign):
-    """`snakemake validate` on a copy of the small campaign; then -n: nothing; an edit of validate: only it.
-    Then `snakemake discrepancy` (light settings) runs that stage alone on top and writes its outputs."""
-    import shutil
-    import subprocess
-    import sys
-
-    import yaml
-    from _campaign import REPO
-
-    work = tmp_path / "wf"
-    work.mkdir()
-    shutil.copy(REPO / "Snakefile", work)
-    for folder in ("workflow", "profiles"):
-        shutil.copytree(REPO / folder, work / folder, ignore=shutil.ignore_patterns("__pycache__"))
-    small = {"calibrate": {"population": 20, "offspring": 20, "generations": 3, "n_polish": 0},
-             "posterior": {"max_steps": 100, "chunk": 100, "predictive_draws": 10}, "validate": {"n_draws": 2}}
-    (work / "small.yaml").write_text(yaml.safe_dump(small))
-    out = tmp_path / "results"
-
-    def smk(*args):
-        return subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", *args, "--configfile", "small.yaml",
-                               "--config", f"raw_data={small_campaign}", f"results={out}"], cwd=work,
-                              capture_output=True, text=True, timeout=600)
-
-    res = smk("validate")
-    assert res.returncode == 0, res.stderr
-    summary = json.loads((out / "validation" / "first" / "summary.json").read_text())
-    assert np.isfinite(summary["E"]) and "peak response" in summary["words"]
-    metrics = pd.read_csv(out / "validation" / "first" / "metrics.csv")
-    assert len(metrics) == 5 and (metrics["n_frames"] > 0).all()
-    assert (out / "figures" / "fig3_11_validation.png").stat().st_size > 10_000
-    assert "validation envelope error E" in (out / "logs" / "validate" / "first.log").read_text()
-    assert "Nothing to be done" in smk("-n", "validate").stdout
-    small["validate"]["n_draws"] = 3
-    (work / "small.yaml").write_text(yaml.safe_dump(small))
-    dry = smk("-n", "validate").stdout
-    assert "validate_assembly" in dry and "calibrate_assembly" not in dry and "posterior_assembly" not in dry
-    small["validate"]["n_draws"] = 2
-    small["discrepancy"] = {"candidates": ["sensor_gain", "channel_delay"], "max_nfev": 8, "max_frames": 24,
-                            "ga_generations": 2, "posterior_steps": 100}
-    (work / "small.yaml").write_text(yaml.safe_dump(small))
-    res = smk("discrepancy")
-    assert res.returncode == 0, res.stderr
-    ran = set(re.findall(r"rule (\w+):", res.stdout + res.stderr))
-    assert ran == {"discrepancy_assembly", "discrepancy_table", "discrepancy"}, ran
-    d = json.loads((out / "discrepancy" / "first" / "diagnosis.json").read_text())
-    assert d["effect"] in {"sensor_gain", "channel_delay", "none", "unexplained"}
-    assert np.isfinite(d["metric_before"]) and np.isfinite(d["metric_after"]) and "emcee" in d["recalibrated"]["method"]
-    assert (out / "discrepancy" / "first" / "diagnosis.md").read_text().startswith("# Discrepancy diagnosis")
-    assert "<table>" in (out / "discrepancy" / "table_3_2_corrected.html").read_text()

@@ -2,12 +2,15 @@
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
+import yaml
 from _campaign import REPO, edit_run, workflow_copy
 
 pytestmark = pytest.mark.slow
@@ -24,9 +27,34 @@ def _snakemake(work: Path, *args: str) -> subprocess.CompletedProcess[str]:
                           timeout=900)
 
 
-def test_ingest_rule_tabulates_every_run(workdir, tmp_path, small_campaign):
-    out = tmp_path / "results"
-    res = _snakemake(workdir, "--cores", "2", "ingest", "--config", f"raw_data={small_campaign}", f"results={out}")
+# light settings: these tests check the wiring and the reruns; test_calibrate, test_posterior, test_validate and
+# test_discrepancy check the methods
+SMALL = {"calibrate": {"population": 20, "offspring": 20, "generations": 3, "n_polish": 0},
+         "posterior": {"max_steps": 100, "chunk": 100, "predictive_draws": 10}, "validate": {"n_draws": 2}}
+
+
+@pytest.fixture(scope="module")
+def small_run(tmp_path_factory, small_campaign) -> tuple[Path, Path, subprocess.CompletedProcess[str]]:
+    """One workflow copy and one run on the small campaign, shared by the tests below: a bare `snakemake
+    validate` (no --cores: the default profile) with light settings (small.yaml). Each test that edits
+    small.yaml puts it back."""
+    tmp = tmp_path_factory.mktemp("small_run")
+    work = workflow_copy(tmp)
+    (work / "small.yaml").write_text(yaml.safe_dump(SMALL))
+    out = tmp / "results"
+    res = _snakemake(work, "validate", "--configfile", "small.yaml", "--config", f"raw_data={small_campaign}",
+                     f"results={out}")
+    return work, out, res
+
+
+def _again(small_run, small_campaign, *args: str) -> subprocess.CompletedProcess[str]:
+    work, out, _ = small_run
+    return _snakemake(work, "--cores", "2", *args, "--configfile", "small.yaml", "--config",
+                      f"raw_data={small_campaign}", f"results={out}")
+
+
+def test_ingest_rule_tabulates_every_run(small_run, small_campaign):
+    _, out, res = small_run
     assert res.returncode == 0, res.stderr
     runs = pd.read_csv(out / "ingest" / "runs.csv")
     manifest = pd.read_csv(small_campaign / "manifest.csv")
@@ -34,13 +62,52 @@ def test_ingest_rule_tabulates_every_run(workdir, tmp_path, small_campaign):
     assert "ingested 5 runs" in (out / "logs" / "ingest.log").read_text()
 
 
-def test_bare_run_uses_default_profile(workdir, tmp_path, small_campaign):
-    out = tmp_path / "results"
-    # no --cores; one stage only (the whole workflow with the default GA and chain takes minutes)
-    res = _snakemake(workdir, "ingest", "--config", f"raw_data={small_campaign}", f"results={out}")
+def test_bare_run_uses_default_profile(small_run):
+    _, out, res = small_run
     assert res.returncode == 0, res.stderr
     assert "profiles/default" in res.stderr + res.stdout
     assert (out / "ingest" / "runs.csv").is_file()
+
+
+def test_validate_stage_reruns_only_itself_on_a_config_edit(small_run, small_campaign):
+    """`snakemake validate` on the small campaign; then -n: nothing; an edit of validate: only it."""
+    work, out, res = small_run
+    assert res.returncode == 0, res.stderr
+    summary = json.loads((out / "validation" / "first" / "summary.json").read_text())
+    assert np.isfinite(summary["E"]) and "peak response" in summary["words"]
+    metrics = pd.read_csv(out / "validation" / "first" / "metrics.csv")
+    assert len(metrics) == 5 and (metrics["n_frames"] > 0).all()
+    assert (out / "figures" / "fig3_11_validation.png").stat().st_size > 10_000
+    assert "validation envelope error E" in (out / "logs" / "validate" / "first.log").read_text()
+    assert "Nothing to be done" in _again(small_run, small_campaign, "-n", "validate").stdout
+    edited = {**SMALL, "validate": {"n_draws": 3}}
+    (work / "small.yaml").write_text(yaml.safe_dump(edited))
+    try:
+        dry = _again(small_run, small_campaign, "-n", "validate").stdout
+    finally:
+        (work / "small.yaml").write_text(yaml.safe_dump(SMALL))
+    assert "validate_assembly" in dry and "calibrate_assembly" not in dry and "posterior_assembly" not in dry
+
+
+def test_discrepancy_target_runs_that_stage_alone_on_top(small_run, small_campaign):
+    """`snakemake discrepancy` (light settings) after the validation runs that stage alone and writes its outputs."""
+    work, out, res = small_run
+    assert res.returncode == 0, res.stderr
+    light = {**SMALL, "discrepancy": {"candidates": ["sensor_gain", "channel_delay"], "max_nfev": 8,
+                                      "max_frames": 24, "ga_generations": 2, "posterior_steps": 100}}
+    (work / "small.yaml").write_text(yaml.safe_dump(light))
+    try:
+        res = _again(small_run, small_campaign, "discrepancy")
+    finally:
+        (work / "small.yaml").write_text(yaml.safe_dump(SMALL))
+    assert res.returncode == 0, res.stderr
+    ran = set(re.findall(r"rule (\w+):", res.stdout + res.stderr))
+    assert ran == {"discrepancy_assembly", "discrepancy_table", "discrepancy"}, ran
+    d = json.loads((out / "discrepancy" / "first" / "diagnosis.json").read_text())
+    assert d["effect"] in {"sensor_gain", "channel_delay", "none", "unexplained"}
+    assert np.isfinite(d["metric_before"]) and np.isfinite(d["metric_after"]) and "emcee" in d["recalibrated"]["method"]
+    assert (out / "discrepancy" / "first" / "diagnosis.md").read_text().startswith("# Discrepancy diagnosis")
+    assert "<table>" in (out / "discrepancy" / "table_3_2_corrected.html").read_text()
 
 
 def test_malformed_campaign_fails_naming_the_file(workdir, tmp_path, campaign):

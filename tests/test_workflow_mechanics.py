@@ -15,11 +15,12 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pandas as pd
 import pytest
-from _campaign import REPO, SMALL_CAMPAIGN
+from _campaign import REPO, SMALL_CAMPAIGN, edit_manifest
 from _modal_tables import TABLE_3_2, write_tables
 
-from jointcal._workflow import config_problem, stage_sources
+from jointcal._workflow import campaign_index, config_problem, pending_outputs, stage_sources
 from jointcal.calibrate import CalibrateSettings, run_calibration
 from jointcal.posterior import PosteriorSettings, run_posterior
 
@@ -99,6 +100,38 @@ def test_ga_generation_and_chain_tau_reach_the_log_while_running(tmp_path):
     assert [ln.split(":")[0] for ln in lines] == ["posterior step 100/200", "posterior step 200/200"]
     assert re.search(r"largest autocorrelation time \d+ steps, chain [\d.]+ tau \(stops at 50 tau\); checkpoint ",
                      lines[-1]), lines[-1]
+
+
+def test_campaign_index_reads_the_manifest_and_keeps_its_problem(campaign):
+    manifest = pd.read_csv(SMALL_CAMPAIGN / "manifest.csv", dtype=str)
+    index = campaign_index(SMALL_CAMPAIGN / "manifest.csv")
+    assert list(index.run_files) == list(manifest["run_id"]) and index.problem is None
+    assert index.run_files[manifest["run_id"][0]] == str(SMALL_CAMPAIGN / manifest["file"][0])
+    assert index.assemblies == list(dict.fromkeys(manifest["assembly"])) and index.excitation == "base"
+    first = manifest["assembly"][0]
+    assert index.assembly_files(first) == [str(SMALL_CAMPAIGN / f) for f in manifest.loc[manifest["assembly"] == first,
+                                                                                         "file"]]
+    # a listed record that is missing: the names still come through, with read_manifest's sentence kept
+    edit_manifest(campaign, lambda d: d.assign(file=d["file"].where(d.index > 0, "gone.csv")))
+    broken = campaign_index(campaign / "manifest.csv")
+    assert list(broken.run_files) == list(manifest["run_id"]) and broken.excitation == "base"
+    assert "gone.csv: the file of run" in broken.problem
+    edit_manifest(campaign, lambda d: d.rename(columns={"level_g": "level_V"}))  # the records are not read
+    assert campaign_index(campaign / "manifest.csv").excitation == "voltage"
+
+
+def test_pending_outputs_are_the_planned_files_written_before_the_run(tmp_path):
+    old, new, done = tmp_path / "old.csv", tmp_path / "new.csv", tmp_path / "done.csv"
+    for f in (old, done, new):
+        f.write_text("x\n")
+    os.utime(old, (1000.0, 1000.0))
+    os.utime(done, (1000.0, 1000.0))
+    summary = ("output_file\tdate\trule\tlog-file(s)\tstatus\tplan\n"
+               f"{old}\t-\tr\t-\tok\tupdate pending\n{done}\t-\tr\t-\tok\tno update\n"
+               f"{new}\t-\tr\t-\tok\tupdate pending\n{tmp_path / 'missing.csv'}\t-\tr\t-\tmissing\tupdate pending\n"
+               f"{tmp_path}\t-\tr\t-\tok\tupdate pending\n")
+    assert pending_outputs(summary, before=2000.0) == [old]  # not new (written since), done, missing, a folder
+    assert pending_outputs("Building DAG of jobs...", before=2000.0) == []
 
 
 # ------------------------------------------------------------------ Snakemake runs (slow)
@@ -186,7 +219,7 @@ def test_discrepancy_target_runs_only_that_stage_and_what_it_needs(touched, tmp_
         module.write_text(original)
     fresh = ["--config", f"raw_data={SMALL_CAMPAIGN}", f"results={tmp_path / 'fresh'}"]
     jobs = set(_jobs(_snakemake(work, "-n", "discrepancy", *fresh)))
-    assert {"ingest", "envelopes_run", "calibrate_assembly", "validate_assembly", "discrepancy_assembly",
+    assert {"ingest", "envelopes_runs", "calibrate_assembly", "validate_assembly", "discrepancy_assembly",
             "discrepancy_table"} <= jobs
     assert not jobs & {"modal_figures", "calibration_figures", "posterior_corner", "validate_figures",
                        "report_summary"}, jobs
@@ -208,7 +241,7 @@ def test_typo_in_config_is_one_line_before_any_schema_dump(touched):
 
 
 @pytest.mark.slow
-def test_slurm_profile_dry_run_has_one_job_per_run_and_per_assembly(tmp_path):
+def test_slurm_profile_dry_run_has_one_job_per_assembly(tmp_path):
     """On the example campaign (24 runs, 2 assemblies), with the profile's per-rule resources."""
     work = tmp_path / "wf"
     work.mkdir()
@@ -218,7 +251,7 @@ def test_slurm_profile_dry_run_has_one_job_per_run_and_per_assembly(tmp_path):
     res = _snakemake(work, "-n", "--workflow-profile", "workflow/profiles/slurm",
                      "--config", f"raw_data={REPO / 'raw_data'}", f"results={tmp_path / 'results'}")
     assert "workflow/profiles/slurm" in res.stderr + res.stdout
-    assert _jobs(res) == {"ingest": 1, "envelopes_run": 24, "modal_properties": 1, "modal_figures": 1,
+    assert _jobs(res) == {"ingest": 1, "envelopes_runs": 1, "modal_properties": 1, "modal_figures": 1,
                           "calibrate_assembly": 2, "calibration_figures": 2, "posterior_assembly": 2,
                           "posterior_corner": 2, "posterior_report": 1, "report_summary": 1,
                           "validate_assembly": 2, "validate_figures": 1, "discrepancy_assembly": 2,
@@ -226,7 +259,8 @@ def test_slurm_profile_dry_run_has_one_job_per_run_and_per_assembly(tmp_path):
     blocks = re.findall(r"rule (\w+):\n(?:    .*\n)*?    resources: (.*)", res.stdout + res.stderr)
     resources = {rule: dict(kv.split("=", 1) for kv in line.split(", ")) for rule, line in blocks}
     assert resources["calibrate_assembly"]["runtime"] == "30" and resources["posterior_assembly"]["runtime"] == "60"
-    assert resources["envelopes_run"]["runtime"] == "5" and resources["ingest"]["cpus_per_task"] == "1"
+    assert resources["envelopes_runs"]["runtime"] == "15" and resources["ingest"]["cpus_per_task"] == "1"
+    assert resources["envelopes_runs"]["cpus_per_task"] == "2" == resources["validate_assembly"]["cpus_per_task"]
 
 
 @pytest.mark.slow

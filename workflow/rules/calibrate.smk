@@ -1,15 +1,10 @@
 # Stage calibrate: GA (DEAP) per assembly on the paper's eq. 3.9 (jointcal.calibrate), and its figures.
 # GA checkpoints live in <results>/checkpoints/ (not declared outputs: Snakemake deletes
 # those before a rerun, and an interrupted GA resumes from its checkpoint).
-import re
-
-CALIBRATION = RESULTS / "calibration"
-ASSEMBLY_RE = "|".join(re.escape(a) for a in ASSEMBLIES) or "no-assembly"
-
 
 rule calibrate_assembly:
     input:
-        modal=RESULTS / "modal" / "modal_properties.csv",
+        modal=MODAL / "modal_properties.csv",
     output:
         best=CALIBRATION / "{assembly}" / "ga_best.json",
         history=CALIBRATION / "{assembly}" / "ga_history.csv",
@@ -22,8 +17,9 @@ rule calibrate_assembly:
     wildcard_constraints:
         assembly=ASSEMBLY_RE,
     threads: 1
+    priority: 10  # on the longest chain of jobs (figures and tables fill the gaps)
     benchmark:
-        RESULTS / "benchmarks" / "calibrate" / "{assembly}.tsv"
+        RESULTS / "benchmarks" / "calibrate_assembly" / "{assembly}.tsv"
     log:
         RESULTS / "logs" / "calibrate" / "{assembly}.log",
     script:
@@ -36,13 +32,13 @@ rule calibration_figures:
         logbook=CALIBRATION / "{assembly}" / "ga_logbook.csv",
         best=CALIBRATION / "{assembly}" / "ga_best.json",
     output:
-        exploration=report(RESULTS / "figures" / "ga_exploration_{assembly}.png",
+        exploration=report(FIGURES / "ga_exploration_{assembly}.png",
                            caption="../report/ga_exploration.rst", category="2. Calibration",
                            subcategory="{assembly}"),
-        convergence=report(RESULTS / "figures" / "ga_convergence_{assembly}.png",
+        convergence=report(FIGURES / "ga_convergence_{assembly}.png",
                            caption="../report/ga_convergence.rst", category="2. Calibration",
                            subcategory="{assembly}"),
-        caption=RESULTS / "report" / "ga_{assembly}.rst",
+        caption=REPORT / "ga_{assembly}.rst",
     params:
         code=source_hash("calibration_figures.py"),
         calibrate=config.get("calibrate", {}),
@@ -60,5 +56,5 @@ rule calibration_figures:
 rule calibrate:
     input:
         expand(CALIBRATION / "{assembly}" / "ga_best.json", assembly=ASSEMBLIES),
-        expand(RESULTS / "figures" / "ga_exploration_{assembly}.png", assembly=ASSEMBLIES),
-        expand(RESULTS / "figures" / "ga_convergence_{assembly}.png", assembly=ASSEMBLIES),
+        expand(FIGURES / "ga_exploration_{assembly}.png", assembly=ASSEMBLIES),
+        expand(FIGURES / "ga_convergence_{assembly}.png", assembly=ASSEMBLIES),

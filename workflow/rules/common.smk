@@ -1,14 +1,16 @@
-# Shared paths and input functions of the jointcal workflow (logic lives in src/jointcal/).
-import csv
-import os
+# Shared names, paths and input functions of the jointcal workflow (logic lives in src/jointcal/); every
+# stage's file uses them, so the stage files may be included in any order after this one.
+import re
+import subprocess
 import sys
-import warnings
+import time
 from pathlib import Path
 
+from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
-from jointcal._workflow import config_problem, stage_hash
-from jointcal.io import CampaignError, CampaignWarning, excitation_kind, read_manifest, write_bytes_atomic
+from jointcal._workflow import campaign_index, config_problem, pending_outputs, stage_hash
+from jointcal.io import write_bytes_atomic
 
 # Config: an unknown key (a typo) is one line naming the nearest valid key, before the schema's own
 # validation (whose message is a dump of the schema); nested --config values given as text are converted.
@@ -39,37 +41,49 @@ if not MANIFEST.is_file():
         "with --config raw_data=PATH/TO/CAMPAIGN."
     )
 
-
-def _manifest_rows():
-    """The manifest's rows as text, read leniently at parse time (a workflow of the later stages only,
-    started from their tables, may hold a manifest of run_id, assembly and file alone)."""
-    with open(MANIFEST, newline="", encoding="utf-8-sig") as fh:
-        return [{(k or "").strip(): (v or "").strip() for k, v in r.items()} for r in csv.DictReader(fh)]
-
-
-RUN_FILES = {r["run_id"]: str(RAW_DATA / r.get("file", "")) for r in _manifest_rows() if r.get("run_id")}
+# The campaign, read once with jointcal.io.read_manifest (jointcal._workflow.campaign_index): a manifest
+# that fails its checks still names the jobs, and the rules that read raw records stop on its error.
+CAMPAIGN = campaign_index(MANIFEST)
+RUN_FILES = CAMPAIGN.run_files
 RUN_IDS = list(RUN_FILES)
-ASSEMBLIES = list(dict.fromkeys(r["assembly"] for r in _manifest_rows() if r.get("assembly")))
-# the campaign's reference kind from the manifest's level column (base unless level_lbf / level_V)
-EXCITATION = excitation_kind(_manifest_rows()[0]) if _manifest_rows() else "base"
-_CHECKED = []
+ASSEMBLIES = CAMPAIGN.assemblies
+ASSEMBLY_RE = "|".join(re.escape(a) for a in ASSEMBLIES) or "no-assembly"
+EXCITATION = CAMPAIGN.excitation  # base, force or voltage, from the manifest's level column
+
+# Each stage's folder under RESULTS (stages in the order data flows).
+INGEST = RESULTS / "ingest"
+ENVELOPES = RESULTS / "envelopes"
+MODAL = RESULTS / "modal"
+CALIBRATION = RESULTS / "calibration"
+POSTERIOR = RESULTS / "posterior"
+VALIDATION = RESULTS / "validation"
+DISCREPANCY = RESULTS / "discrepancy"
+DESIGN = RESULTS / "design"
+FIGURES = RESULTS / "figures"
+REPORT = RESULTS / "report"  # the summary page and the run-generated captions
+
+
+def pool_threads(wildcards):
+    """Threads of a per-assembly job that spreads its runs over a process pool (validate, discrepancy): the
+    cores shared among the assemblies, so the assemblies' jobs run side by side (most of such a job is one
+    process; its pool serves part of it), and all of them for a campaign of one assembly."""
+    try:
+        cores = int(workflow.cores)
+    except (WorkflowError, TypeError, ValueError):  # no --cores (a dry run or --lint)
+        return 1
+    return max(1, min(cores, 64) // max(1, len(ASSEMBLIES)))
 
 
 def checked_campaign():
-    """Read and check the manifest once, with jointcal.io.read_manifest, in the input function of every rule
-    that reads raw records: a Windows path, a listed file that is missing or any other manifest problem
-    stops the workflow there with the one-sentence message on stderr and in the ingest log, before
-    Snakemake looks for the records (its MissingInputException names no fix). Notes on the manifest
-    (empty trailing rows) are left to the ingest stage's log."""
-    if not _CHECKED:
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", CampaignWarning)
-                _CHECKED.append(read_manifest(MANIFEST))
-        except CampaignError as exc:
-            write_bytes_atomic(f"jointcal: {exc}\n".encode(), RESULTS / "logs" / "ingest.log")
-            sys.exit(f"jointcal: {exc}")
-    return _CHECKED[0]
+    """Stop on the manifest's problem, if it has one, in the input function of every rule that reads raw
+    records: a Windows path, a listed file that is missing or any other manifest problem stops the workflow
+    there with the one-sentence message on stderr and in the ingest log, before Snakemake looks for the
+    records (its MissingInputException names no fix). Notes on the manifest (empty trailing rows) are left
+    to the ingest stage's log."""
+    if CAMPAIGN.problem:
+        write_bytes_atomic(f"jointcal: {CAMPAIGN.problem}\n".encode(), RESULTS / "logs" / "ingest.log")
+        sys.exit(f"jointcal: {CAMPAIGN.problem}")
+    return CAMPAIGN
 
 
 def campaign_files(wildcards):
@@ -92,13 +106,11 @@ def run_record(wildcards):
 
 def ingest_table(wildcards):
     """The ingest stage's runs.csv when the workflow has that stage (one of calibrate + posterior only has not)."""
-    return [str(RESULTS / "ingest" / "runs.csv")] if has_rule("ingest") else []
+    return [str(INGEST / "runs.csv")] if has_rule("ingest") else []
 
 
 def has_rule(name):
     """Whether this workflow defines rule `name` (called when the DAG is built, after every include)."""
-    from snakemake.exceptions import WorkflowError
-
     try:
         getattr(rules, name)
     except (WorkflowError, AttributeError):
@@ -110,35 +122,43 @@ def verdict_inputs(wildcards):
     """The later stages' outputs the verdict reads, for the stages this workflow has."""
     out = {}
     if has_rule("validate_assembly"):
-        out["validation"] = [str(RESULTS / "validation" / a / "summary.json") for a in ASSEMBLIES]
+        out["validation"] = [str(VALIDATION / a / "summary.json") for a in ASSEMBLIES]
     if has_rule("discrepancy_assembly") and EXCITATION == "base":
-        out["diagnosis"] = [str(RESULTS / "discrepancy" / a / "diagnosis.json") for a in ASSEMBLIES]
+        out["diagnosis"] = [str(DISCREPANCY / a / "diagnosis.json") for a in ASSEMBLIES]
     if has_rule("design_assembly"):
-        out["design"] = [str(RESULTS / "design" / a / "next_test.json") for a in ASSEMBLIES]
+        out["design"] = [str(DESIGN / a / "next_test.json") for a in ASSEMBLIES]
     return out
 
 
 def assembly_records(wildcards):
     """The raw records of one assembly's runs, once the manifest is checked."""
-    table = checked_campaign()
-    return [RUN_FILES[rid] for rid, asm in zip(table["run_id"], table["assembly"]) if asm == wildcards.assembly]
+    return checked_campaign().assembly_files(wildcards.assembly)
+
+
+STARTED = time.time()  # when this run parsed the workflow: outputs written since are this run's
 
 
 def remove_stale_outputs():
-    """After a failed run, remove the outputs of every job the run had scheduled and did not finish.
+    """After a failed run, remove the outputs the same command still plans to remake and this run did not.
 
     Snakemake deletes the outputs of the job that failed; those of the previous run further down
-    (calibration, posterior, figures, table) would stay and look current. A job scheduled to rerun
-    has outdated outputs (its inputs, code hash or params changed, or an upstream job reran), so
-    they go; finished jobs, logs, benchmarks and the GA/chain checkpoints stay (a rerun resumes).
+    (calibration, posterior, figures, table) would stay and look current. Snakemake's own summary of the
+    same command (``--summary``: the plan for each output file) names the outputs whose jobs are still to
+    run (their inputs, code hash or params changed, or an upstream job reran or failed), so those
+    written before this run go; finished jobs, logs, benchmarks and the GA/chain checkpoints stay (a
+    rerun resumes).
     """
-    try:  # Snakemake 9's DAG (workflow.dag, DAG.needrun_jobs)
-        jobs = list(workflow.dag.needrun_jobs(exclude_finished=True))
-    except AttributeError:
-        print("jointcal: the run failed; outputs of jobs that did not run may be out of date "
-              "(this Snakemake version does not show which)", file=sys.stderr)
+    kept = {"logs", "benchmarks", "checkpoints"}  # never outputs of a job
+    if not any(f.is_file() and f.stat().st_mtime < STARTED for f in RESULTS.rglob("*")
+               if not kept & set(f.relative_to(RESULTS).parts[:1])):
+        return  # nothing from before this run that could be out of date (e.g. a first run that failed)
+    cli = Path(sys.argv[0])
+    if not (cli.name == "snakemake" or cli.parent.name == "snakemake"):  # run through an API: no command
+        print("jointcal: the run failed; outputs of jobs that did not run may be out of date", file=sys.stderr)
         return
-    stale = [Path(f) for job in jobs for f in job.output if os.path.isfile(f)]
+    summary = subprocess.run([sys.executable, "-m", "snakemake", *sys.argv[1:], "--summary", "--nolock"],
+                             capture_output=True, text=True)
+    stale = pending_outputs(summary.stdout, before=STARTED)
     for f in stale:
         f.unlink(missing_ok=True)
     if stale:

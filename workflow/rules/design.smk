@@ -1,16 +1,14 @@
 # Stage design: which test to run next (jointcal.design), from each assembly's posterior through the
-# fast steady-state model; next_test.json/.csv/.md and a figure. Include after posterior.smk (uses
-# ASSEMBLY_RE and POSTERIOR). A force- or voltage-driven campaign gets the same files saying in words
-# what cannot be recommended.
-DESIGN = RESULTS / "design"
+# fast steady-state model; next_test.json/.csv/.md and a figure. A force- or voltage-driven campaign
+# gets the same files saying in words what cannot be recommended.
 
 
 rule design_assembly:
     input:
-        runs=RESULTS / "ingest" / "runs.csv",
-        modal=RESULTS / "modal" / "modal_properties.csv",
-        scatter=RESULTS / "modal" / "scatter.csv",
-        best=RESULTS / "calibration" / "{assembly}" / "ga_best.json",
+        runs=INGEST / "runs.csv",
+        modal=MODAL / "modal_properties.csv",
+        scatter=MODAL / "scatter.csv",
+        best=CALIBRATION / "{assembly}" / "ga_best.json",
         chain=POSTERIOR / "{assembly}" / "chain.npz",
         identified=POSTERIOR / "{assembly}" / "identified.csv",
     output:
@@ -18,7 +16,7 @@ rule design_assembly:
         csv=DESIGN / "{assembly}" / "next_test.csv",
         markdown=report(DESIGN / "{assembly}" / "next_test.md", caption="../report/next_test_md.rst",
                         category="6. Next test", subcategory="{assembly}"),
-        figure=report(RESULTS / "figures" / "next_test_{assembly}.png", caption="../report/next_test.rst",
+        figure=report(FIGURES / "next_test_{assembly}.png", caption="../report/next_test.rst",
                       category="6. Next test", subcategory="{assembly}"),
     params:
         code=source_hash("design.py"),
@@ -30,7 +28,7 @@ rule design_assembly:
         assembly=ASSEMBLY_RE,
     threads: 1
     benchmark:
-        RESULTS / "benchmarks" / "design_{assembly}.tsv"
+        RESULTS / "benchmarks" / "design_assembly" / "{assembly}.tsv"
     log:
         RESULTS / "logs" / "design" / "{assembly}.log",
     script:
@@ -40,4 +38,4 @@ rule design_assembly:
 rule design:
     input:
         expand(DESIGN / "{assembly}" / "next_test.json", assembly=ASSEMBLIES),
-        expand(RESULTS / "figures" / "next_test_{assembly}.png", assembly=ASSEMBLIES),
+        expand(FIGURES / "next_test_{assembly}.png", assembly=ASSEMBLIES),

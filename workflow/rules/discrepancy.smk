@@ -1,17 +1,16 @@
 # Stage discrepancy: which named effect the calibrated model misses, the model with it, the gap before
-# and after (jointcal.discrepancy). Include after validate.smk (uses VALIDATION, ASSEMBLY_RE).
+# and after (jointcal.discrepancy).
 # Its library holds the Ministack base-driven rig's effects: a force- or voltage-driven campaign
 # (EXCITATION, common.smk) has no discrepancy target, and the README says so.
-DISCREPANCY = RESULTS / "discrepancy"
 
 
 rule discrepancy_assembly:
     input:
-        runs=RESULTS / "ingest" / "runs.csv",
-        modal=RESULTS / "modal" / "modal_properties.csv",
-        env=expand(RESULTS / "envelopes" / "{run_id}.csv", run_id=RUN_IDS),
-        best=RESULTS / "calibration" / "{assembly}" / "ga_best.json",
-        history=RESULTS / "calibration" / "{assembly}" / "ga_history.csv",
+        runs=INGEST / "runs.csv",
+        modal=MODAL / "modal_properties.csv",
+        env=expand(ENVELOPES / "{run_id}.csv", run_id=RUN_IDS),
+        best=CALIBRATION / "{assembly}" / "ga_best.json",
+        history=CALIBRATION / "{assembly}" / "ga_history.csv",
         validation=VALIDATION / "{assembly}" / "summary.json",
         records=assembly_records,
     output:
@@ -20,10 +19,10 @@ rule discrepancy_assembly:
                         category="5. Discrepancy", subcategory="{assembly}"),
         residuals=DISCREPANCY / "{assembly}" / "residuals.csv",
         metrics_after=DISCREPANCY / "{assembly}" / "metrics_after.csv",
-        residual_figure=report(RESULTS / "figures" / "discrepancy_residuals_{assembly}.png",
+        residual_figure=report(FIGURES / "discrepancy_residuals_{assembly}.png",
                                caption="../report/discrepancy_residuals.rst", category="5. Discrepancy",
                                subcategory="{assembly}"),
-        before_after_figure=report(RESULTS / "figures" / "discrepancy_before_after_{assembly}.png",
+        before_after_figure=report(FIGURES / "discrepancy_before_after_{assembly}.png",
                                    caption="../report/discrepancy_before_after.rst", category="5. Discrepancy",
                                    subcategory="{assembly}"),
     params:
@@ -35,9 +34,10 @@ rule discrepancy_assembly:
         modal=config["modal"],
     wildcard_constraints:
         assembly=ASSEMBLY_RE,
-    threads: 2
+    threads: pool_threads
+    priority: 10  # on the longest chain of jobs (figures and tables fill the gaps)
     benchmark:
-        RESULTS / "benchmarks" / "discrepancy_{assembly}.tsv"
+        RESULTS / "benchmarks" / "discrepancy_assembly" / "{assembly}.tsv"
     log:
         RESULTS / "logs" / "discrepancy" / "{assembly}.log",
     script:
@@ -46,7 +46,7 @@ rule discrepancy_assembly:
 
 rule discrepancy_table:
     input:
-        best=expand(RESULTS / "calibration" / "{assembly}" / "ga_best.json", assembly=ASSEMBLIES),
+        best=expand(CALIBRATION / "{assembly}" / "ga_best.json", assembly=ASSEMBLIES),
         diagnosis=expand(DISCREPANCY / "{assembly}" / "diagnosis.json", assembly=ASSEMBLIES),
     output:
         table=report(DISCREPANCY / "table_3_2_corrected.html", caption="../report/table_3_2_corrected.rst",

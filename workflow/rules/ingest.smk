@@ -4,7 +4,7 @@ rule ingest:
     input:
         unpack(campaign_files),
     output:
-        runs=RESULTS / "ingest" / "runs.csv",
+        runs=INGEST / "runs.csv",
     params:
         code=source_hash("ingest.py"),
         ingest=config["ingest"],

@@ -2,17 +2,18 @@
 
 rule modal_properties:
     input:
-        runs=RESULTS / "ingest" / "runs.csv",
-        env=expand(RESULTS / "envelopes" / "{run_id}.csv", run_id=RUN_IDS),
-        meta=expand(RESULTS / "envelopes" / "{run_id}.json", run_id=RUN_IDS),
+        runs=INGEST / "runs.csv",
+        env=expand(ENVELOPES / "{run_id}.csv", run_id=RUN_IDS),
+        meta=expand(ENVELOPES / "{run_id}.json", run_id=RUN_IDS),
         records=campaign_records,
     output:
-        table=RESULTS / "modal" / "modal_properties.csv",
-        scatter=RESULTS / "modal" / "scatter.csv",
-        frf=directory(RESULTS / "modal" / "frf"),
+        table=MODAL / "modal_properties.csv",
+        scatter=MODAL / "scatter.csv",
+        frf=directory(MODAL / "frf"),
     params:
         code=source_hash("modal.py"),
         modal=config["modal"],
+    priority: 10  # on the longest chain of jobs (figures and tables fill the gaps)
     benchmark:
         RESULTS / "benchmarks" / "modal_properties.tsv"
     log:
@@ -23,16 +24,16 @@ rule modal_properties:
 
 rule modal_figures:
     input:
-        table=RESULTS / "modal" / "modal_properties.csv",
-        runs=RESULTS / "ingest" / "runs.csv",
-        env=expand(RESULTS / "envelopes" / "{run_id}.csv", run_id=RUN_IDS),
+        table=MODAL / "modal_properties.csv",
+        runs=INGEST / "runs.csv",
+        env=expand(ENVELOPES / "{run_id}.csv", run_id=RUN_IDS),
         records=campaign_records,
     output:
-        envelopes=report(RESULTS / "figures" / "fig3_5_envelopes.png",
+        envelopes=report(FIGURES / "fig3_5_envelopes.png",
                          caption="../report/fig3_5_envelopes.rst", category="1. Modal properties"),
-        amplitude=report(RESULTS / "figures" / "fig3_6_frequency_damping.png",
+        amplitude=report(FIGURES / "fig3_6_frequency_damping.png",
                          caption="../report/fig3_6_frequency_damping.rst", category="1. Modal properties"),
-        spectrogram=report(RESULTS / "figures" / "spectrogram_ridge.png",
+        spectrogram=report(FIGURES / "spectrogram_ridge.png",
                            caption="../report/spectrogram_ridge.rst", category="1. Modal properties"),
     params:
         code=source_hash("modal_figures.py"),

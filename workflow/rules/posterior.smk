@@ -1,15 +1,12 @@
 # Stage posterior: emcee around each GA optimum (jointcal.posterior); corner plots, Fig. 3.8, Table 3.2.
-# Include after calibrate.smk (uses its ASSEMBLY_RE).
 # Chain checkpoints live in <results>/checkpoints/ (not declared outputs: an interrupted
 # chain resumes from its last chunk).
-POSTERIOR = RESULTS / "posterior"
-
 
 rule posterior_assembly:
     input:
-        modal=RESULTS / "modal" / "modal_properties.csv",
-        scatter=RESULTS / "modal" / "scatter.csv",
-        best=RESULTS / "calibration" / "{assembly}" / "ga_best.json",
+        modal=MODAL / "modal_properties.csv",
+        scatter=MODAL / "scatter.csv",
+        best=CALIBRATION / "{assembly}" / "ga_best.json",
     output:
         summary=POSTERIOR / "{assembly}" / "summary.csv",
         chain=POSTERIOR / "{assembly}" / "chain.npz",
@@ -24,8 +21,9 @@ rule posterior_assembly:
     wildcard_constraints:
         assembly=ASSEMBLY_RE,
     threads: 1
+    priority: 10  # on the longest chain of jobs (figures and tables fill the gaps)
     benchmark:
-        RESULTS / "benchmarks" / "posterior" / "{assembly}.tsv"
+        RESULTS / "benchmarks" / "posterior_assembly" / "{assembly}.tsv"
     log:
         RESULTS / "logs" / "posterior" / "{assembly}.log",
     script:
@@ -36,12 +34,12 @@ rule posterior_corner:
     input:
         chain=POSTERIOR / "{assembly}" / "chain.npz",
         constraints=POSTERIOR / "{assembly}" / "constraints.txt",
-        best=RESULTS / "calibration" / "{assembly}" / "ga_best.json",
-        history=RESULTS / "calibration" / "{assembly}" / "ga_history.csv",
+        best=CALIBRATION / "{assembly}" / "ga_best.json",
+        history=CALIBRATION / "{assembly}" / "ga_history.csv",
     output:
-        corner=report(RESULTS / "figures" / "corner_{assembly}.png", caption="../report/corner.rst",
+        corner=report(FIGURES / "corner_{assembly}.png", caption="../report/corner.rst",
                       category="3. Posterior", subcategory="{assembly}"),
-        caption=RESULTS / "report" / "corner_{assembly}.rst",
+        caption=REPORT / "corner_{assembly}.rst",
     params:
         code=source_hash("posterior_corner.py"),
         calibrate=config.get("calibrate", {}),
@@ -59,14 +57,14 @@ rule posterior_corner:
 
 rule posterior_report:
     input:
-        modal=RESULTS / "modal" / "modal_properties.csv",
-        best=expand(RESULTS / "calibration" / "{assembly}" / "ga_best.json", assembly=ASSEMBLIES),
-        curves=expand(RESULTS / "calibration" / "{assembly}" / "model_curves.csv", assembly=ASSEMBLIES),
+        modal=MODAL / "modal_properties.csv",
+        best=expand(CALIBRATION / "{assembly}" / "ga_best.json", assembly=ASSEMBLIES),
+        curves=expand(CALIBRATION / "{assembly}" / "model_curves.csv", assembly=ASSEMBLIES),
         summary=expand(POSTERIOR / "{assembly}" / "summary.csv", assembly=ASSEMBLIES),
         predictive=expand(POSTERIOR / "{assembly}" / "predictive.csv", assembly=ASSEMBLIES),
         identified=expand(POSTERIOR / "{assembly}" / "identified.csv", assembly=ASSEMBLIES),
     output:
-        figure=report(RESULTS / "figures" / "fig3_8_amplitude_fit.png", caption="../report/fig3_8_amplitude_fit.rst",
+        figure=report(FIGURES / "fig3_8_amplitude_fit.png", caption="../report/fig3_8_amplitude_fit.rst",
                       category="3. Posterior"),
         table=POSTERIOR / "table_3_2.csv",
         markdown=POSTERIOR / "table_3_2.md",
@@ -87,5 +85,5 @@ rule posterior_report:
 rule posterior:
     input:
         expand(POSTERIOR / "{assembly}" / "summary.csv", assembly=ASSEMBLIES),
-        expand(RESULTS / "figures" / "corner_{assembly}.png", assembly=ASSEMBLIES),
+        expand(FIGURES / "corner_{assembly}.png", assembly=ASSEMBLIES),
         rules.posterior_report.output,

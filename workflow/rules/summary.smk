@@ -1,6 +1,6 @@
 # The report's opening summary: the verdict of the whole run (validation E, the discrepancy stage's named
 # effect and what it changed, the identified quantities of the model that holds, the next test), then
-# Table 3.2 and the details (jointcal.report.verdict, jointcal.report.summary). Include last: it reads
+# Table 3.2 and the details (jointcal.report.verdict, jointcal.report.summary). It reads
 # the outputs of every stage the workflow has (common.smk's verdict_inputs; a workflow of the calibration
 # and posterior stages alone gets a summary of those).
 
@@ -9,19 +9,19 @@ rule report_summary:
     input:
         unpack(verdict_inputs),
         runs=ingest_table,
-        modal=RESULTS / "modal" / "modal_properties.csv",
-        scatter=RESULTS / "modal" / "scatter.csv",
+        modal=MODAL / "modal_properties.csv",
+        scatter=MODAL / "scatter.csv",
         table=POSTERIOR / "table_3_2.csv",
-        history=expand(RESULTS / "calibration" / "{assembly}" / "ga_history.csv", assembly=ASSEMBLIES),
-        best=expand(RESULTS / "calibration" / "{assembly}" / "ga_best.json", assembly=ASSEMBLIES),
+        history=expand(CALIBRATION / "{assembly}" / "ga_history.csv", assembly=ASSEMBLIES),
+        best=expand(CALIBRATION / "{assembly}" / "ga_best.json", assembly=ASSEMBLIES),
         chain=expand(POSTERIOR / "{assembly}" / "chain.npz", assembly=ASSEMBLIES),
         constraints=expand(POSTERIOR / "{assembly}" / "constraints.txt", assembly=ASSEMBLIES),
         identified=expand(POSTERIOR / "{assembly}" / "identified.csv", assembly=ASSEMBLIES),
     output:
-        summary=report(RESULTS / "report" / "summary.html", caption="../report/summary.rst",
+        summary=report(REPORT / "summary.html", caption="../report/summary.rst",
                        category="0. Summary"),
         table=report(POSTERIOR / "table_3_2.html", caption="../report/table_3_2.rst", category="3. Posterior"),
-        landing=RESULTS / "report" / "landing.html",
+        landing=REPORT / "landing.html",
     params:
         code=source_hash("report_summary.py"),
         calibrate=config.get("calibrate", {}),

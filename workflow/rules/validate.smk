@@ -1,14 +1,12 @@
 # Stage validate: the calibrated model driven by each run's measured base record, through the
 # same envelopes and modal code (jointcal.validate); Fig. 3.11.
-# Include after posterior.smk (uses ASSEMBLY_RE and POSTERIOR).
-VALIDATION = RESULTS / "validation"
 
 
 rule validate_assembly:
     input:
-        runs=RESULTS / "ingest" / "runs.csv",
-        modal=RESULTS / "modal" / "modal_properties.csv",
-        best=RESULTS / "calibration" / "{assembly}" / "ga_best.json",
+        runs=INGEST / "runs.csv",
+        modal=MODAL / "modal_properties.csv",
+        best=CALIBRATION / "{assembly}" / "ga_best.json",
         chain=POSTERIOR / "{assembly}" / "chain.npz",
         records=assembly_records,
     output:
@@ -22,9 +20,10 @@ rule validate_assembly:
         modal=config["modal"],
     wildcard_constraints:
         assembly=ASSEMBLY_RE,
-    threads: 2
+    threads: pool_threads
+    priority: 10  # on the longest chain of jobs (figures and tables fill the gaps)
     benchmark:
-        RESULTS / "benchmarks" / "validate_{assembly}.tsv"
+        RESULTS / "benchmarks" / "validate_assembly" / "{assembly}.tsv"
     log:
         RESULTS / "logs" / "validate" / "{assembly}.log",
     script:
@@ -37,7 +36,7 @@ rule validate_figures:
         summary=expand(VALIDATION / "{assembly}" / "summary.json", assembly=ASSEMBLIES),
         envelopes=expand(VALIDATION / "{assembly}" / "envelopes", assembly=ASSEMBLIES),
     output:
-        figure=report(RESULTS / "figures" / "fig3_11_validation.png", caption="../report/fig3_11_validation.rst",
+        figure=report(FIGURES / "fig3_11_validation.png", caption="../report/fig3_11_validation.rst",
                       category="4. Validation"),
     params:
         code=source_hash("validate_figures.py"),

@@ -2,7 +2,7 @@
 its convergence, the GA best, the polished optimum, the prior bounds and its modes; and the run-generated
 part of its caption.
 
-Axes in the sampling space (log10 of the scale parameters and noise scales, chi linear).
+Axes: log10 of the scale parameters and noise scales, chi linear (jointcal.report._corner_axes).
 (No ``from __future__``: Snakemake prepends a preamble to scripts.)
 """
 import json
@@ -11,9 +11,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from jointcal.calibrate import LOG_SCALED, PARAMS, CalibrateSettings
+from jointcal.calibrate import PARAMS, CalibrateSettings
 from jointcal.io import write_bytes_atomic
 from jointcal.posterior import PosteriorSettings
+from jointcal.report._corner_axes import corner_coordinates
 from jointcal.report.corner import corner_figure
 from jointcal.report.summary import chain_status, ga_best_point, rst_escape
 
@@ -25,19 +26,9 @@ def main(smk) -> None:
     with np.load(smk.input.chain) as z:
         arrays = {k: z[k] for k in z.files}
     samples, names = arrays["samples"], [str(n) for n in arrays["sample_names"]]
-    log = [LOG_SCALED.get(n, True) for n in names]
-    x = np.where(log, np.log10(np.abs(samples)), samples)
-    labels = [f"log10 {n}" if lg else n for n, lg in zip(names, log)]
-
-    def coords(point: dict) -> list:
-        return [(np.log10(point[n]) if lg else point[n]) if n in point else np.nan for n, lg in zip(names, log)]
-
-    points = {"GA best": coords(ga_best_point(pd.read_csv(smk.input.history))),
-              "polished optimum": coords({p: best[p] for p in PARAMS})}
-    full = cal.full_bounds
-    lo = [full[n][0] if n in full else np.nan for n in names]
-    hi = [full[n][1] if n in full else np.nan for n in names]
-    bounds = (coords(dict(zip(names, lo))), coords(dict(zip(names, hi))))
+    points = {"GA best": ga_best_point(pd.read_csv(smk.input.history)),
+              "polished optimum": {p: best[p] for p in PARAMS}}
+    x, labels, points, bounds = corner_coordinates(samples, names, points, cal.full_bounds)
     ok, line = chain_status(arrays, tau_factor=post.tau_factor)
     modes = arrays.get("sample_mode")
     write_bytes_atomic(corner_figure(x, labels, title=f"posterior of {smk.wildcards.assembly}", points=points,

@@ -15,7 +15,8 @@ import numpy as np
 import pandas as pd
 
 from jointcal.io import excitation_kind, listed_record, read_run, write_csv_atomic, write_json_atomic
-from jointcal.validate import ValidateSettings, model_from_best, models_from_samples, validate_runs
+from jointcal.validate import ValidateSettings, models_from_samples, validate_runs
+from jointcal.validate.models import run_models
 from jointcal.validate.runs import drive_gain
 
 
@@ -34,20 +35,14 @@ def main(smk) -> None:
         gain = drive_gain(modal_table[modal_table["assembly"] == asm]) if excitation_kind(records[0]) != "base" else None
         if gain is not None:  # a force or voltage drives the mode through the campaign's modal constant
             rows = [{**r, "drive_gain": gain} for r in rows]
-        f_res = {r["run_id"]: float(modal.loc[r["run_id"], "f_res_hz"]) for r in rows if r["run_id"] in modal.index}
-        f_ref = float(np.nanmedian(list(f_res.values()))) if f_res else None
+        models, f_ref = run_models(best, modal["f_res_hz"].to_dict(), [r["run_id"] for r in rows])
         with np.load(smk.input.chain) as z:
             samples = z["samples"]
         draws = models_from_samples(samples, float(best["m"]), s.n_draws, np.random.default_rng(s.seed),
                                     viscous=str(best.get("viscous", "dashpot")), f_ref_hz=f_ref)
-
-        def model_for(row):
-            f = f_res.get(row["run_id"], np.nan)
-            return model_from_best(best, f_ref_hz=f if np.isfinite(f) else f_ref)
-
         n = max(1, int(smk.threads))
         with ProcessPoolExecutor(max_workers=n) if n > 1 else _Serial() as ex:
-            v = validate_runs(model_for, records, rows, settings=s, draws=draws, envelopes_kw=dict(smk.params.envelopes),
+            v = validate_runs(models, records, rows, settings=s, draws=draws, envelopes_kw=dict(smk.params.envelopes),
                               modal_kw=dict(smk.params.modal), executor=ex if n > 1 else None)
     except ValueError as exc:
         log.parent.mkdir(parents=True, exist_ok=True)

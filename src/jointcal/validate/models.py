@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike
 from ..calibrate.space import PARAMS as _KEYS
 from ..models import IwanParams, MinistackModel
 
-__all__ = ["model_from_params", "model_from_best", "models_from_samples"]
+__all__ = ["model_from_params", "model_from_best", "models_from_samples", "run_models"]
 
 
 def model_from_params(params: Mapping[str, float], m: float, *, viscous: str = "dashpot",
@@ -93,3 +93,34 @@ def models_from_samples(samples: ArrayLike, m: float, n_draws: int, rng: np.rand
     pick = rng.choice(len(s), size=min(int(n_draws), len(s)), replace=False) if len(s) else []
     return [model_from_params(dict(zip(_KEYS, s[i])), m, viscous=viscous, f_ref_hz=f_ref_hz)
             for i in np.sort(pick)]
+
+
+def run_models(best: Mapping[str, Any], f_res_hz: Mapping[str, float],
+               run_ids: list[str]) -> tuple[list[MinistackModel], float | None]:
+    """The optimum's model for each run, and the reference frequency its posterior draws use.
+
+    f_ref (needed only for ``viscous: constant``, see `model_from_params`) is each run's own
+    measured resonance, or, for a run without one, the median over the runs that have one;
+    the draws, shared by every run, take that median.
+
+    Parameters
+    ----------
+    best : mapping
+        ga_best.json's content.
+    f_res_hz : mapping of str to float
+        Measured resonance per run_id (modal_properties.csv's ``f_res_hz``, Hz; NaN or absent
+        where a run has none).
+    run_ids : list of str
+        The runs, in the order of the models returned.
+
+    Returns
+    -------
+    models : list of MinistackModel
+        One per run of `run_ids`.
+    f_ref_hz : float or None
+        The median resonance (Hz), None when no run has one.
+    """
+    f = {r: float(f_res_hz[r]) for r in run_ids if r in f_res_hz}
+    f_ref = float(np.nanmedian(list(f.values()))) if f else None
+    models = [model_from_best(best, f_ref_hz=f[r] if np.isfinite(f.get(r, np.nan)) else f_ref) for r in run_ids]
+    return models, f_ref
