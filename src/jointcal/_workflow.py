@@ -8,10 +8,9 @@ workflow passes the hash as a rule's ``params`` so that editing ``jointcal.measu
 the modal rules and their descendants, and nothing upstream. Not seen: imports built at
 run time (``importlib``), third-party packages, and data files read by the package.
 
-`campaign_index` reads the campaign's manifest once, with `jointcal.io.read_manifest`, for
-the names the workflow's DAG is built from (run ids, record files, assemblies, excitation).
-
-`pending_outputs` reads Snakemake's ``--summary`` table for the files still planned to be remade.
+`campaign_index` and `pending_outputs` (in `jointcal._campaign_index`, re-exported here): the
+campaign's manifest read once for the DAG's names, and the files Snakemake's ``--summary`` still
+plans to remake.
 
 `config_problem` checks a merged config against the workflow's JSON schema before
 Snakemake's own ``validate`` (whose message is a dump of the schema): an unknown key gets
@@ -25,13 +24,13 @@ import ast
 import difflib
 import hashlib
 import os
-import warnings
 from collections.abc import Mapping, MutableMapping
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import yaml
+
+from ._campaign_index import CampaignIndex, campaign_index, pending_outputs  # noqa: F401 (re-exported)
 
 __all__ = ["stage_sources", "stage_hash", "CampaignIndex", "campaign_index", "pending_outputs", "config_problem"]
 
@@ -118,112 +117,6 @@ def stage_hash(script: str | os.PathLike[str]) -> str:
         rel = f.relative_to(_ROOT).as_posix() if f.is_relative_to(_ROOT) else f.name
         h.update(rel.encode() + b"\0" + f.read_bytes() + b"\0")
     return h.hexdigest()[:16]
-
-
-@dataclass(frozen=True)
-class CampaignIndex:
-    """What the workflow's DAG is built from, read from a campaign's manifest at parse time.
-
-    Attributes
-    ----------
-    run_files : dict of str to str
-        run_id -> the run's record file (the manifest's folder joined with its ``file``), in manifest order.
-    run_assembly : dict of str to str
-        run_id -> its assembly.
-    excitation : {'base', 'force', 'voltage'}
-        The campaign's reference, from its level column (``level_g``, ``level_lbf``, ``level_V``).
-    problem : str or None
-        `read_manifest`'s one-sentence error when the manifest fails its checks (then the names
-        above come from its ``run_id``, ``assembly`` and ``file`` columns alone), else None.
-    """
-
-    run_files: dict[str, str]
-    run_assembly: dict[str, str]
-    excitation: str
-    problem: str | None = None
-
-    @property
-    def assemblies(self) -> list[str]:
-        """The assemblies, in order of first appearance."""
-        return list(dict.fromkeys(a for a in self.run_assembly.values() if a))
-
-    def assembly_files(self, assembly: str) -> list[str]:
-        """The record files of one assembly's runs, in manifest order."""
-        return [f for r, f in self.run_files.items() if self.run_assembly.get(r) == assembly]
-
-
-def campaign_index(manifest: str | os.PathLike[str]) -> CampaignIndex:
-    """Read a campaign's manifest once for the workflow: `jointcal.io.read_manifest`, every check.
-
-    A manifest that fails the checks (a missing record, a Windows path, an empty cell) does not stop
-    the parse: its ``run_id``, ``assembly`` and ``file`` columns still name the jobs, and the error is
-    kept in ``problem`` for the rules that read raw records, which stop on it with its sentence. So a
-    workflow of the later stages, run on their tables with a manifest of those three columns, builds.
-
-    Parameters
-    ----------
-    manifest : path-like
-        The campaign's ``manifest.csv`` (it must exist).
-
-    Returns
-    -------
-    CampaignIndex
-    """
-    import pandas as pd
-
-    from jointcal.io import CampaignError, CampaignWarning, excitation_kind, read_manifest
-
-    manifest = Path(manifest)
-    problem = None
-    try:
-        with warnings.catch_warnings():  # notes on the manifest (trailing empty rows) are the ingest stage's
-            warnings.simplefilter("ignore", CampaignWarning)
-            table = read_manifest(manifest)
-    except CampaignError as exc:
-        problem = str(exc)
-        try:
-            table = pd.read_csv(manifest, dtype=str, keep_default_na=False, encoding="utf-8-sig")
-        except (ValueError, UnicodeDecodeError):
-            table = pd.DataFrame()
-        table = table.rename(columns=lambda c: str(c).strip()).apply(lambda c: c.str.strip())
-        if not {"run_id", "assembly"} <= set(table.columns):
-            table = pd.DataFrame(columns=["run_id", "assembly", "file"])
-        table = table[table["run_id"] != ""]
-    files = table["file"] if "file" in table else pd.Series("", index=table.index)
-    ids = [str(r) for r in table["run_id"]]
-    return CampaignIndex(run_files={r: str(manifest.parent / str(f)) for r, f in zip(ids, files)},
-                         run_assembly=dict(zip(ids, (str(a) for a in table["assembly"]))),
-                         excitation=excitation_kind(table.columns),
-                         problem=problem)
-
-
-def pending_outputs(summary: str, *, before: float) -> list[Path]:
-    """The existing output files that Snakemake's summary plans to remake, last written before `before`.
-
-    Parameters
-    ----------
-    summary : str
-        The text ``snakemake --summary`` prints: a tab-separated table with the columns
-        ``output_file`` and ``plan`` (``update pending`` for an output whose job is to run).
-    before : float
-        A time (s since the epoch, as `time.time`); files written since are left out.
-
-    Returns
-    -------
-    list of Path
-        Regular files only (a ``directory()`` output is left alone), in the summary's order.
-    """
-    lines = [ln.split("\t") for ln in summary.splitlines() if "\t" in ln]
-    if not lines or "output_file" not in lines[0] or "plan" not in lines[0]:
-        return []
-    col_file, col_plan = lines[0].index("output_file"), lines[0].index("plan")
-    out = []
-    for row in lines[1:]:
-        if len(row) > max(col_file, col_plan) and row[col_plan] == "update pending":
-            f = Path(row[col_file])
-            if f.is_file() and f.stat().st_mtime < before:
-                out.append(f)
-    return out
 
 
 def _resolve(schema: Mapping[str, Any], root: Mapping[str, Any]) -> Mapping[str, Any]:
