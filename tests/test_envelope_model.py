@@ -174,3 +174,20 @@ def test_fold_branches_follow_the_sweep_direction():
         f_sim = fs_[np.argmin(d)]  # the steepest fall along the sweep: the jump
         print(f"\nsweep {fa:.0f}->{fb:.0f} Hz: model jump {f_model:.1f} Hz, simulated {f_sim:.1f} Hz")
         assert 0 <= (f_sim - f_model) * np.sign(fb - fa) < 5.0
+
+
+def test_irregular_frames_stay_finite_and_below_the_dashpot_bound():
+    """Frames almost at one frequency with base levels jumping 10x between them (a dwell, a stepped sine)
+    once threw the branch continuation's extrapolated guess to q = inf. Every amplitude is finite and
+    below the closed-form bound m A / (c omega): |K_z - m omega^2| >= Im K_z >= c omega (the joint only
+    adds dissipation)."""
+    rng = np.random.default_rng(3)
+    f = np.sort(rng.uniform(1500.0, 2700.0, 60))
+    base = rng.uniform(0.5, 5.0, 60)
+    k, zv = 6.12e5 * 1.1, 0.0015
+    model = MinistackModel(m=M, k=k, zeta_v=zv, iwan=IwanParams(626.0, 1.02e6, -0.65, 0.004))
+    for direction in ("up", "down"):
+        q = steady_state(model, f, base, direction=direction).q_in
+        c = 2 * zv * np.sqrt((k + 1.02e6) * M)
+        assert np.all(np.isfinite(q))
+        assert np.all(q <= M * base * G / (c * 2 * np.pi * f))

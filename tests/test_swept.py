@@ -106,3 +106,26 @@ def test_drive_checks_are_one_sentence():
         SweepDrive(np.array([0.0, 0.2, 0.1, 0.3]), np.ones(4), np.ones(4), 0.01)
     with pytest.raises(ValueError, match="one value per frame"):
         SweepDrive(np.arange(4.0), np.ones(3), np.ones(4), 0.01)
+
+
+def test_several_runs_of_one_model_equal_one_run_at_a_time():
+    """quasi_steady_runs computes the joint's terms once: every run's envelope is bitwise quasi_steady's,
+    for a batch of parameter sets on the flexible fixture, up and down, with rates and ramps."""
+    from jointcal.models.swept import quasi_steady_runs
+
+    P = 3
+    model = MinistackModel(m=M, k=K * np.linspace(0.9, 1.1, P)[:, None], zeta_v=ZV,
+                           iwan=IwanParams(313.0 * np.array([[1.0], [0.5], [2.0]]), 1.02e6, -0.65, 0.004),
+                           fixture=Fixture(4 * M, 5500.0, 0.01), sensor_gain=1.02, sensor_delay_s=2e-6)
+    rng = np.random.default_rng(3)
+    runs = []
+    for n, direction, rate in ((40, "up", 400.0), (25, "down", -300.0), (60, "up", 800.0)):
+        f = np.sort(rng.uniform(1500.0, 2700.0, n))
+        runs.append((f if direction == "up" else f[::-1], rng.uniform(0.5, 5.0, n), rate * np.ones(n),
+                     rng.normal(0.0, 0.2, n), direction))
+    together = quasi_steady_runs(model, runs)
+    for (f, b, r, dl, d), T in zip(runs, together):
+        alone = quasi_steady(model, f, b, rate_hz_per_s=r, dlog_base_per_s=dl, direction=d)
+        assert T.shape == alone.shape == (P, f.size)
+        assert np.array_equal(T, alone)
+        assert np.all(np.isfinite(T))

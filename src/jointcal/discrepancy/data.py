@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import pandas as pd
@@ -49,6 +50,14 @@ class RunEnvelope:
     t_s: NDArray[np.float64] | None = None
     drive: SweepDrive | None = None
     transient: NDArray[np.complex128] | None = None
+
+    @cached_property
+    def drive_rates(self) -> tuple[NDArray, NDArray] | None:
+        """df/dt (Hz/s) and dlog A/dt (1/s) of the drive at the frames (None without a drive): computed
+        once per run, as every evaluation of the fast model reads them."""
+        if self.drive is None or self.t_s is None:
+            return None
+        return self.drive.at(self.t_s)[2:]
 
 
 def run_zeta(row: Mapping) -> float:

@@ -30,7 +30,8 @@ from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
 from ..calibrate.space import PARAMS, ParamSpace
-from ..models import MinistackModel, quasi_steady, swept_transmissibility
+from ..models import MinistackModel, swept_transmissibility
+from ..models.swept import quasi_steady_runs
 from .data import RunEnvelope, run_zeta
 from ..effects import EFFECTS, apply_effect, effects_of
 
@@ -93,15 +94,23 @@ def model_at(c: Candidate, theta: NDArray, row: Mapping) -> MinistackModel:
     return apply_effect(c.grown.model(th, c.m), c.name, values, row)
 
 
+def _drive(run: RunEnvelope) -> tuple:
+    """The run's frames as `quasi_steady_runs` takes them: f, base, rate, dlog A/dt, direction."""
+    rate, dlog = (run.rate, 0.0) if run.drive_rates is None else run.drive_rates
+    return run.f_hz, run.base_g, rate, dlog, "up" if run.rate >= 0 else "down"
+
+
+def _first_order_runs(c: Candidate, theta: NDArray, runs: Sequence[RunEnvelope]) -> list[NDArray[np.complex128]]:
+    """The first-order quasi-steady envelope at each run's frames, (P, n) or (n,) per run: one model for
+    all runs, unless the candidate changes with the run's place in the sequence."""
+    if c.sequence_dependent:
+        return [quasi_steady_runs(model_at(c, theta, run.row), [_drive(run)])[0] for run in runs]
+    return quasi_steady_runs(model_at(c, theta, runs[0].row), [_drive(run) for run in runs])
+
+
 def _first_order(c: Candidate, theta: NDArray, run: RunEnvelope) -> NDArray[np.complex128]:
     """The first-order quasi-steady envelope at the run's frames, (P, n) or (n,)."""
-    model = model_at(c, theta, run.row)
-    direction = "up" if run.rate >= 0 else "down"
-    if run.drive is None or run.t_s is None:
-        rate, dlog = run.rate, 0.0
-    else:
-        _, _, rate, dlog = run.drive.at(run.t_s)
-    return quasi_steady(model, run.f_hz, run.base_g, rate_hz_per_s=rate, dlog_base_per_s=dlog, direction=direction)
+    return _first_order_runs(c, theta, [run])[0]
 
 
 def predict(c: Candidate, theta: NDArray, run: RunEnvelope) -> NDArray[np.complex128]:
@@ -128,8 +137,9 @@ def with_transient(c: Candidate, theta: NDArray, runs: Sequence[RunEnvelope]) ->
     return out
 
 
-def _run_residual(c: Candidate, theta: NDArray, run: RunEnvelope, n_runs: int) -> NDArray:
-    d = predict(c, theta, run) / run.T
+def _run_residual(T: NDArray, run: RunEnvelope, n_runs: int) -> NDArray:
+    """Weighted magnitude (dB) and phase (deg) errors of first-order envelope T at the run's frames."""
+    d = (T if run.transient is None else T * run.transient) / run.T
     w = 1.0 / np.sqrt(2.0 * run.f_hz.size * n_runs)
     dm = 20 * np.log10(np.abs(d)) / run.sigma_db
     dp = np.degrees(np.angle(d)) / run.sigma_deg
@@ -139,7 +149,8 @@ def _run_residual(c: Candidate, theta: NDArray, run: RunEnvelope, n_runs: int) -
 def residuals(c: Candidate, theta: NDArray, runs: Sequence[RunEnvelope]) -> NDArray:
     """Residual vector whose sum of squares is E^2 (theta (n,) -> (m,), (P, n) -> (P, m))."""
     with np.errstate(all="ignore"):
-        r = np.concatenate([_run_residual(c, theta, run, len(runs)) for run in runs], axis=-1)
+        T = _first_order_runs(c, theta, runs)
+        r = np.concatenate([_run_residual(t, run, len(runs)) for t, run in zip(T, runs)], axis=-1)
     return np.where(np.isfinite(r), r, 1e3)
 
 
@@ -193,6 +204,7 @@ def fit_candidate(c: Candidate, runs: Sequence[RunEnvelope], theta0: NDArray, *,
             inits.append(u)
     h = 1e-5
     count = [0]
+    last = {}  # the latest evaluation: least squares asks the Jacobian where it has just evaluated
 
     def full(v):
         u = u0.copy()
@@ -201,7 +213,8 @@ def fit_candidate(c: Candidate, runs: Sequence[RunEnvelope], theta0: NDArray, *,
 
     def fun(v):
         count[0] += 1
-        return residuals(c, c.to_physical(full(v)), runs)
+        last["v"], last["r"] = np.array(v, dtype=float), residuals(c, c.to_physical(full(v)), runs)
+        return last["r"]
 
     def jac(v):
         u = full(v)
@@ -211,7 +224,8 @@ def fit_candidate(c: Candidate, runs: Sequence[RunEnvelope], theta0: NDArray, *,
         U[np.arange(idx.size), idx] += step
         count[0] += 1
         R = residuals(c, c.to_physical(U), runs)
-        return ((R - fun(v)) / step[:, None]).T
+        r0 = last["r"] if "v" in last and np.array_equal(last["v"], v) else fun(v)
+        return ((R - r0) / step[:, None]).T
 
     best = None
     for u in inits:

@@ -59,7 +59,8 @@ class Effect:
     advice: Callable[[Mapping[str, float]], str]
     fingerprint: Fingerprint | None = None
     hidden: Mapping[str, float] | None = None  # None: the parameters' start values
-    sequence_dependent: bool = False  # the model changes with the run's place in the test sequence
+    sequence_dependent: bool = False  # the model changes with the run's place in the test sequence (apply reads
+    # its row); False: one model serves every run of a parameter set (the discrepancy fits build it once)
     library: bool = True
     summary: str = ""  # what it is, in a line
 

@@ -209,8 +209,8 @@ def _solve(w, mu_re, mu_im, logB, s_start, order, kp, c, KT, R, chi, phimax, S, 
             if jj >= 2:  # continue the branch by linear extrapolation in frequency
                 n1 = order[jj - 1]
                 n2 = order[jj - 2]
-                if w[n1] != w[n2]:
-                    guess = s + (s - s_prev) * (w[n] - w[n1]) / (w[n1] - w[n2])
+                if w[n1] != w[n2]:  # at most a factor e: frames close in frequency must not throw it far
+                    guess = s + max(-1.0, min(1.0, (s - s_prev) * (w[n] - w[n1]) / (w[n1] - w[n2])))
             s_prev = s
             s, jumped, re, im = _root(guess, w[n], mu_re[p, n], mu_im[p, n], logB[p, n], kp[p], c[p], KT[p], R[p],
                                       chi[p], phimax[p], S[p], J1[p], codes, coefs[p], nodes, weights, tol)

@@ -50,6 +50,7 @@ neglected, as is the can's own transient where the fixture's mode lies inside th
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Literal
@@ -62,7 +63,7 @@ from ..units import G
 from .envelope import _NODES, _WEIGHTS, _amplitudes, _batch_shape, _field, _joint_terms
 from .structure import MinistackModel
 
-__all__ = ["SweepDrive", "quasi_steady", "swept_transmissibility", "sweep_eta", "ETA_MIN", "SPAN", "CAP"]
+__all__ = ["SweepDrive", "quasi_steady", "quasi_steady_runs", "swept_transmissibility", "sweep_eta", "ETA_MIN", "SPAN", "CAP"]
 
 ETA_MIN = 0.02  # below this eta the first-order quasi-steady envelope is as close as the integrated one
 SPAN = 3.0  # integrated from x = -SPAN through the resonance, half-power half-widths
@@ -144,14 +145,16 @@ def _linearised(D: NDArray, Ks: NDArray, Z0: NDArray, rhs: NDArray) -> NDArray:
 
 
 def _quasi_steady(model: MinistackModel, f: NDArray, base_g: NDArray, rate: NDArray, dlog: NDArray,
-                  direction: str) -> tuple[NDArray, NDArray, NDArray]:
-    """(R, Z, A): slug acceleration envelope (in/s^2), joint envelope Z_0 + Z_1 (in), base (in/s^2), (P, N)."""
+                  direction: str, joint: tuple | None = None) -> tuple[NDArray, NDArray, NDArray]:
+    """(R, Z, A): slug acceleration envelope (in/s^2), joint envelope Z_0 + Z_1 (in), base (in/s^2), (P, N).
+
+    joint : the model's `_joint_terms` when already at hand (they do not depend on the frequencies)."""
     shape, _ = _batch_shape(model, f.shape)
     P, N = shape
     w = 2 * np.pi * f
     A = np.broadcast_to(np.asarray(base_g, float), f.shape) * G
     m = _field(model.m, shape)
-    joint = _joint_terms(model, shape)
+    joint = _joint_terms(model, shape) if joint is None else joint
     mu, mu1, mu2, F, F1, F2 = _derivs(model, w, shape)
     gamma = None if model.fixture is None else -F / m[:, None]
     s, _, kre, kim = _amplitudes(f, A, direction, shape, joint, m, mu if gamma is not None else mu.real, gamma)
@@ -214,6 +217,24 @@ def quasi_steady(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike = 1.0
     R, _, A = _quasi_steady(model, f, np.broadcast_to(np.asarray(base_g, float), f.shape),
                             rate_hz_per_s, dlog_base_per_s, direction)
     return (R / A * _sensor(model, f, shape)).reshape(out_shape)
+
+
+def quasi_steady_runs(model: MinistackModel, runs: Sequence[tuple]) -> list[NDArray[np.complex128]]:
+    """`quasi_steady` of one model (one parameter set or a batch) along several runs' frames.
+
+    runs : one (f_hz (N,), base_g (N,), rate_hz_per_s, dlog_base_per_s, direction) per run, as
+    `quasi_steady`'s arguments. The joint's terms, which do not depend on the frames, are
+    computed once; each run's result equals `quasi_steady`'s.
+    """
+    out, joint = [], None
+    for f_hz, base_g, rate, dlog, direction in runs:
+        f = np.atleast_1d(np.asarray(f_hz, dtype=float))
+        shape, out_shape = _batch_shape(model, f.shape)
+        joint = _joint_terms(model, shape) if joint is None else joint
+        R, _, A = _quasi_steady(model, f, np.broadcast_to(np.asarray(base_g, float), f.shape), rate, dlog,
+                                direction, joint)
+        out.append((R / A * _sensor(model, f, shape)).reshape(out_shape))
+    return out
 
 
 def swept_transmissibility(model: MinistackModel, drive: SweepDrive, t_s: ArrayLike, *, f_res_hz: float,
