@@ -117,8 +117,11 @@ def _derivs(model: MinistackModel, w: NDArray, shape) -> tuple[NDArray, ...]:
     """
     m = _field(model.m, shape)[:, None]
     z = np.zeros((shape[0], w.size), complex)
-    if model.fixture is None:
-        return m * w**2 + z, 2 * m * w + z, 2 * m + z, -m + z, z, z
+    if model.fixture is None:  # real values as complex arrays (P, N)
+        out = [np.empty_like(z) for _ in range(4)]
+        for o, v in zip(out, (m * w**2, 2 * m * w, 2 * m, -m)):
+            o.real, o.imag = v, 0.0
+        return (*out, z, z)
     fx = model.fixture
     mc = _field(fx.m_can, shape)[:, None]
     kc0 = mc * (2 * np.pi * _field(fx.f_can, shape)[:, None]) ** 2
@@ -144,11 +147,29 @@ def _linearised(D: NDArray, Ks: NDArray, Z0: NDArray, rhs: NDArray) -> NDArray:
     return Z0 * (a + 1j * b)
 
 
+def _segment_amplitudes(f: NDArray, A: NDArray, segments: Sequence[tuple[int, int, str]], shape, joint, m: NDArray,
+                        mu: NDArray, gamma: NDArray | None) -> tuple[NDArray, ...]:
+    """`envelope._amplitudes` of runs laid end to end along f: each segment (start, stop, direction)
+    is continued on its own, as a run alone would be."""
+    P = shape[0]
+    out = (np.empty((P, f.size)), np.zeros((P, f.size), dtype=np.bool_), np.empty((P, f.size)), np.empty((P, f.size)))
+    for a, b, direction in segments:
+        part = _amplitudes(f[a:b], A[a:b], direction, (P, b - a), joint, m, mu[:, a:b],
+                           None if gamma is None else gamma[:, a:b])
+        for whole, piece in zip(out, part):
+            whole[:, a:b] = piece
+    return out
+
+
 def _quasi_steady(model: MinistackModel, f: NDArray, base_g: NDArray, rate: NDArray, dlog: NDArray,
-                  direction: str, joint: tuple | None = None) -> tuple[NDArray, NDArray, NDArray]:
+                  direction: str, joint: tuple | None = None,
+                  segments: Sequence[tuple[int, int, str]] | None = None) -> tuple[NDArray, NDArray, NDArray]:
     """(R, Z, A): slug acceleration envelope (in/s^2), joint envelope Z_0 + Z_1 (in), base (in/s^2), (P, N).
 
-    joint : the model's `_joint_terms` when already at hand (they do not depend on the frequencies)."""
+    joint : the model's `_joint_terms` when already at hand (they do not depend on the frequencies).
+    segments : (start, stop, direction) of several runs laid end to end along f, each continued on its
+    own (`_segment_amplitudes`; direction is then unused); None: f is one run.
+    Every other step is elementwise in the frames, so a run's values do not depend on its neighbours."""
     shape, _ = _batch_shape(model, f.shape)
     P, N = shape
     w = 2 * np.pi * f
@@ -157,7 +178,9 @@ def _quasi_steady(model: MinistackModel, f: NDArray, base_g: NDArray, rate: NDAr
     joint = _joint_terms(model, shape) if joint is None else joint
     mu, mu1, mu2, F, F1, F2 = _derivs(model, w, shape)
     gamma = None if model.fixture is None else -F / m[:, None]
-    s, _, kre, kim = _amplitudes(f, A, direction, shape, joint, m, mu if gamma is not None else mu.real, gamma)
+    mu_joint = mu if gamma is not None else mu.real
+    s, _, kre, kim = (_amplitudes(f, A, direction, shape, joint, m, mu_joint, gamma) if segments is None
+                      else _segment_amplitudes(f, A, segments, shape, joint, m, mu_joint, gamma))
     q = np.exp(s)
     Kz = kre + 1j * kim
     D = Kz - mu
@@ -223,18 +246,19 @@ def quasi_steady_runs(model: MinistackModel, runs: Sequence[tuple]) -> list[NDAr
     """`quasi_steady` of one model (one parameter set or a batch) along several runs' frames.
 
     runs : one (f_hz (N,), base_g (N,), rate_hz_per_s, dlog_base_per_s, direction) per run, as
-    `quasi_steady`'s arguments. The joint's terms, which do not depend on the frames, are
-    computed once; each run's result equals `quasi_steady`'s.
+    `quasi_steady`'s arguments. The runs are laid end to end and evaluated in one pass (each
+    continued along its own sweep); each run's result equals `quasi_steady`'s bit for bit.
     """
-    out, joint = [], None
-    for f_hz, base_g, rate, dlog, direction in runs:
-        f = np.atleast_1d(np.asarray(f_hz, dtype=float))
-        shape, out_shape = _batch_shape(model, f.shape)
-        joint = _joint_terms(model, shape) if joint is None else joint
-        R, _, A = _quasi_steady(model, f, np.broadcast_to(np.asarray(base_g, float), f.shape), rate, dlog,
-                                direction, joint)
-        out.append((R / A * _sensor(model, f, shape)).reshape(out_shape))
-    return out
+    f = [np.atleast_1d(np.asarray(r[0], dtype=float)) for r in runs]
+    ends = np.cumsum([0, *(x.size for x in f)])
+    segments = [(int(a), int(b), r[4]) for a, b, r in zip(ends[:-1], ends[1:], runs)]
+    f_all = np.concatenate(f)
+    base, rate, dlog = (np.concatenate([np.broadcast_to(np.asarray(r[i], float), x.shape) for r, x in zip(runs, f)])
+                        for i in (1, 2, 3))
+    shape, out_shape = _batch_shape(model, f_all.shape)
+    R, _, A = _quasi_steady(model, f_all, base, rate, dlog, "up", segments=segments)
+    T = (R / A * _sensor(model, f_all, shape)).reshape(out_shape)
+    return [T[..., a:b] for a, b, _ in segments]
 
 
 def swept_transmissibility(model: MinistackModel, drive: SweepDrive, t_s: ArrayLike, *, f_res_hz: float,
