@@ -1,5 +1,6 @@
 # jointcal workflow: swept-sine shaker campaign -> calibrated Iwan joint models.
 # Stages, in the order data flows (workflow/rules/<stage>.smk; logic in src/jointcal/):
+#   (kernels  numba kernels compiled once, beside ingest      -> <results>/kernels/numba.txt)
 #   ingest     validate the campaign (manifest + run files) -> <results>/ingest/runs.csv
 #   envelopes  drive ridge + complex amplitudes per run     -> <results>/envelopes/<run_id>.csv
 #   modal      resonance, damping, scatter, figures, FRFs    -> <results>/modal/modal_properties.csv, frf/
@@ -29,6 +30,7 @@ report: "workflow/report/workflow.rst"
 
 
 include: "workflow/rules/common.smk"  # checks and validates the config first
+include: "workflow/rules/kernels.smk"
 include: "workflow/rules/ingest.smk"
 include: "workflow/rules/envelopes.smk"
 include: "workflow/rules/modal.smk"

@@ -246,3 +246,23 @@ def test_residual_posterior_samples_a_known_gaussian_in_any_space_with_a_column_
     for p, mu, sd in (("a", 4.0, 0.5), ("b", 6.0, 1.0)):
         assert q.at[p, "median"] == pytest.approx(mu, abs=0.1 * sd)
         assert q.at[p, "q95"] - q.at[p, "q05"] == pytest.approx(2 * 1.6449 * sd, rel=0.08)
+
+
+def test_integrated_time_is_emceess_estimator_and_the_ar1_closed_form():
+    """The batched autocorrelation time equals emcee's estimator to rounding, and on long AR(1)
+    chains the closed form tau = (1 + rho) / (1 - rho) within 10% (the estimator's error, a few %)."""
+    import emcee
+
+    from jointcal.posterior.sampler import integrated_time
+
+    rng = np.random.default_rng(7)
+    for n_t, rho in ((50, 0.5), (3000, 0.9), (20000, 0.8)):
+        x = np.empty((n_t, 32, 3))
+        x[0] = rng.normal(size=(32, 3))
+        for t in range(1, n_t):
+            x[t] = rho * x[t - 1] + np.sqrt(1 - rho**2) * rng.normal(size=(32, 3))
+        x[..., 2] = 1e3 * np.exp(x[..., 2])  # scale and skew do not matter
+        ours = integrated_time(x)
+        np.testing.assert_allclose(ours, emcee.autocorr.integrated_time(x, tol=0), rtol=1e-12)
+        if n_t >= 20000:  # long enough for the estimator's own error (a few %) to be small
+            np.testing.assert_allclose(ours[:2], (1 + rho) / (1 - rho), rtol=0.1)

@@ -58,6 +58,7 @@ CALIBRATION = RESULTS / "calibration"
 POSTERIOR = RESULTS / "posterior"
 VALIDATION = RESULTS / "validation"
 DISCREPANCY = RESULTS / "discrepancy"
+KERNELS = RESULTS / "kernels" / "numba.txt"  # the numba kernels compiled (kernels.smk)
 DESIGN = RESULTS / "design"
 FIGURES = RESULTS / "figures"
 REPORT = RESULTS / "report"  # the summary page and the run-generated captions

@@ -11,6 +11,7 @@ rule design_assembly:
         best=CALIBRATION / "{assembly}" / "ga_best.json",
         chain=POSTERIOR / "{assembly}" / "chain.npz",
         identified=POSTERIOR / "{assembly}" / "identified.csv",
+        kernels=ancient(KERNELS),
     output:
         json=DESIGN / "{assembly}" / "next_test.json",
         csv=DESIGN / "{assembly}" / "next_test.csv",

@@ -13,6 +13,7 @@ rule discrepancy_assembly:
         history=CALIBRATION / "{assembly}" / "ga_history.csv",
         validation=VALIDATION / "{assembly}" / "summary.json",
         records=assembly_records,
+        kernels=ancient(KERNELS),
     output:
         diagnosis=DISCREPANCY / "{assembly}" / "diagnosis.json",
         markdown=report(DISCREPANCY / "{assembly}" / "diagnosis.md", caption="../report/discrepancy_md.rst",

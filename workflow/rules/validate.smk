@@ -9,6 +9,7 @@ rule validate_assembly:
         best=CALIBRATION / "{assembly}" / "ga_best.json",
         chain=POSTERIOR / "{assembly}" / "chain.npz",
         records=assembly_records,
+        kernels=ancient(KERNELS),
     output:
         metrics=VALIDATION / "{assembly}" / "metrics.csv",
         summary=VALIDATION / "{assembly}" / "summary.json",
