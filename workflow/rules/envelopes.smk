@@ -14,6 +14,7 @@ rule envelopes_runs:
         code=source_hash("envelopes.py"),
         envelopes=config["envelopes"],
     threads: 2
+    priority: 10  # on the longest chain of jobs (before compile_kernels, which waits for it)
     benchmark:
         RESULTS / "benchmarks" / "envelopes_runs.tsv"
     log:

@@ -26,6 +26,7 @@ for Fs, KT, beta, k, zeta_v and uniform for chi; in y that density carries the J
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -70,12 +71,12 @@ class LogPosterior:
         if not (np.all(np.isfinite(lo)) and np.all(10.0**lo < np.asarray(self.noise_max))):
             raise ValueError(f"noise floors {10.0**lo} must be finite and below noise_max {self.noise_max}")
 
-    @property
+    @cached_property  # read at every evaluation: computed once
     def q_ref(self) -> float:
         """Reference amplitude of the S_ref coordinate: geometric mean of the measured q, in."""
         return float(np.exp(np.mean(np.log(self.data.q))))
 
-    @property
+    @cached_property  # read at every evaluation: computed once
     def joint(self) -> list[int]:
         """Columns of the joint's parameters (`PARAMS` order) in x and of their y coordinates."""
         return [self.space.index(p) for p in PARAMS]
@@ -104,17 +105,17 @@ class LogPosterior:
         """Number of sampled coordinates (8 for the joint's space)."""
         return self.space.ndim + 2
 
-    @property
+    @cached_property  # read at every evaluation: computed once
     def noise_lo(self) -> NDArray[np.float64]:
         """log10 of the noise floors, shape (2,)."""
         return np.log10(np.asarray(self.data.rel_noise, dtype=float))
 
-    @property
+    @cached_property  # read at every evaluation: computed once
     def lower(self) -> NDArray[np.float64]:
         """Prior lower bounds in x (GA space + noise), shape (ndim,)."""
         return np.r_[self.space.x_lo, self.noise_lo]
 
-    @property
+    @cached_property  # read at every evaluation: computed once
     def upper(self) -> NDArray[np.float64]:
         """Prior upper bounds in x (GA space + noise), shape (ndim,)."""
         return np.r_[self.space.x_hi, np.log10(self.noise_max)]
