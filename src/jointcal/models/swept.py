@@ -126,25 +126,33 @@ def _derivs(model: MinistackModel, w: NDArray, shape) -> tuple[NDArray, ...]:
     mc = _field(fx.m_can, shape)[:, None]
     kc0 = mc * (2 * np.pi * _field(fx.f_can, shape)[:, None]) ** 2
     cc = 2.0 * _field(fx.zeta_can, shape)[:, None] * np.sqrt(kc0 * mc)
+    w2, w3, w4, m2 = w**2, w**3, w**4, m**2  # powers taken once (the same values as inline)
     kc, kc1 = kc0 + 1j * w * cc, 1j * cc + z
-    a, a1, a2 = kc - w**2 * (mc + m), kc1 - 2 * w * (mc + m), -2 * (mc + m) + z
-    mu = m * w**2 + m**2 * w**4 / a
-    mu1 = 2 * m * w + m**2 * (4 * w**3 / a - w**4 * a1 / a**2)
-    mu2 = 2 * m + m**2 * (12 * w**2 / a - 8 * w**3 * a1 / a**2 - w**4 * a2 / a**2 + 2 * w**4 * a1**2 / a**3)
+    a, a1, a2 = kc - w2 * (mc + m), kc1 - 2 * w * (mc + m), -2 * (mc + m) + z
+    a_sq, a_cube, a1_sq = a**2, a**3, a1**2
+    mu = m * w2 + m2 * w4 / a
+    mu1 = 2 * m * w + m2 * (4 * w3 / a - w4 * a1 / a_sq)
+    mu2 = 2 * m + m2 * (12 * w2 / a - 8 * w3 * a1 / a_sq - w4 * a2 / a_sq + 2 * w4 * a1_sq / a_cube)
     F = -m * kc / a
-    F1 = -m * (kc1 / a - kc * a1 / a**2)
-    F2 = -m * (-2 * kc1 * a1 / a**2 - kc * a2 / a**2 + 2 * kc * a1**2 / a**3)
+    F1 = -m * (kc1 / a - kc * a1 / a_sq)
+    F2 = -m * (-2 * kc1 * a1 / a_sq - kc * a2 / a_sq + 2 * kc * a1_sq / a_cube)
     return mu, mu1, mu2, F, F1, F2
 
 
-def _linearised(D: NDArray, Ks: NDArray, Z0: NDArray, rhs: NDArray) -> NDArray:
-    """v with D v + Z0 Ks Re(conj(Z0) v) / |Z0|^2 = rhs (the balance linearised about Z0)."""
-    p = rhs / Z0  # v = Z0 u: D u + Ks Re(u) = p, two real equations in (Re u, Im u)
-    Dr, Di, Kr, Ki = D.real, D.imag, Ks.real, Ks.imag
-    det = (Dr + Kr) * Dr + Di * (Di + Ki)
-    a = (p.real * Dr + Di * p.imag) / det
-    b = ((Dr + Kr) * p.imag - (Di + Ki) * p.real) / det
-    return Z0 * (a + 1j * b)
+def _linearised(D: NDArray, Ks: NDArray, Z0: NDArray):
+    """The solver of D v + Z0 Ks Re(conj(Z0) v) / |Z0|^2 = rhs (the balance linearised about Z0):
+    a function rhs -> v, its coefficients computed once for the several right-hand sides."""
+    Dr, Di, Kr, Ki = D.real, D.imag, Ks.real, Ks.imag  # v = Z0 u: D u + Ks Re(u) = p, two real equations
+    DK, DiK = Dr + Kr, Di + Ki
+    det = DK * Dr + Di * DiK
+
+    def solve(rhs: NDArray) -> NDArray:
+        p = rhs / Z0
+        a = (p.real * Dr + Di * p.imag) / det
+        b = (DK * p.imag - DiK * p.real) / det
+        return Z0 * (a + 1j * b)
+
+    return solve
 
 
 def _segment_amplitudes(f: NDArray, A: NDArray, segments: Sequence[tuple[int, int, str]], shape, joint, m: NDArray,
@@ -192,13 +200,13 @@ def _quasi_steady(model: MinistackModel, f: NDArray, base_g: NDArray, rate: NDAr
     alpha = 2 * np.pi * np.broadcast_to(np.asarray(rate, float), f.shape)
     dl = np.broadcast_to(np.asarray(dlog, float), f.shape)
     with np.errstate(all="ignore"):
-        dZ0 = (alpha * _linearised(D, Ks, Z0, F1 * A - (dKw - mu1) * Z0)
-               + dl * _linearised(D, Ks, Z0, F * A))
+        linearised = _linearised(D, Ks, Z0)
+        dZ0 = alpha * linearised(F1 * A - (dKw - mu1) * Z0) + dl * linearised(F * A)
         Q = (-(1j * mu1 + C) * dZ0 - 0.5j * alpha * mu2 * Z0 - 0.5 * alpha * C1 * Z0 - 1j * F1 * A * dl
              - 0.5j * alpha * F2 * A)
-        Z1 = _linearised(D, Ks, Z0, Q)
-        big = np.abs(Z1) > CAP * q
-        Z1 = np.where(big, Z1 * CAP * q / np.abs(Z1), Z1)
+        Z1 = linearised(Q)
+        size = np.abs(Z1)
+        Z1 = np.where(size > CAP * q, Z1 * CAP * q / size, Z1)
         Z1 = np.where(np.isfinite(Z1), Z1, 0.0)
     force = Kz * (Z0 + Z1) + Z0 * Ks * np.real(np.conj(Z0) * Z1) / q**2 + C * dZ0 + 0.5 * alpha * C1 * Z0
     return -force / m[:, None], Z0 + Z1, np.broadcast_to(A, (P, N))
