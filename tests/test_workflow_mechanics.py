@@ -251,7 +251,7 @@ def test_slurm_profile_dry_run_has_one_job_per_assembly(tmp_path):
     res = _snakemake(work, "-n", "--workflow-profile", "workflow/profiles/slurm",
                      "--config", f"raw_data={REPO / 'raw_data'}", f"results={tmp_path / 'results'}")
     assert "workflow/profiles/slurm" in res.stderr + res.stdout
-    assert _jobs(res) == {"ingest": 1, "envelopes_runs": 1, "modal_properties": 1, "modal_figures": 1,
+    assert _jobs(res) == {"compile_kernels": 1, "ingest": 1, "envelopes_runs": 1, "modal_properties": 1, "modal_figures": 1,
                           "calibrate_assembly": 2, "calibration_figures": 2, "posterior_assembly": 2,
                           "posterior_corner": 2, "posterior_report": 1, "report_summary": 1,
                           "validate_assembly": 2, "validate_figures": 1, "discrepancy_assembly": 2,
