@@ -184,13 +184,26 @@ def _force_campaign(folder: Path, response="driving_point"):
     return row, model, sim
 
 
-def test_force_driven_driving_point(tmp_path):
-    row, model, sim = _force_campaign(tmp_path)
+def _force_measured(folder: Path) -> tuple[pd.DataFrame, dict]:
+    """The force campaign in `folder` through envelopes and the modal read-out: (envelopes, modal row)."""
     from jointcal.io import ingest_campaign, read_run
-    runs = ingest_campaign(tmp_path)
-    df = read_run(tmp_path / "runs" / "f1.csv")
+    runs = ingest_campaign(folder)
+    df = read_run(folder / "runs" / "f1.csv")
     env, meta = envelopes(df, runs.iloc[0].to_dict())
-    out = modal_properties(env, runs.iloc[0].to_dict(), rate_hz_per_s=meta.rate_hz_per_s, record=df)
+    return env, modal_properties(env, runs.iloc[0].to_dict(), rate_hz_per_s=meta.rate_hz_per_s, record=df)
+
+
+@pytest.fixture(scope="module")
+def force_driving_point(tmp_path_factory):
+    """The driving-point force campaign, generated and measured once for the tests that read it."""
+    folder = tmp_path_factory.mktemp("force_driving_point")
+    _, model, _ = _force_campaign(folder)
+    env, out = _force_measured(folder)
+    return model, env, out
+
+
+def test_force_driven_driving_point(force_driving_point):
+    model, env, out = force_driving_point
     p = model.iwan
     f, z = harmonic_balance(out["q_envelope_in"], p.Fs, p.KT, p.chi, p.beta, model.k, model.m, model.zeta_v)
     f_s, z_s = harmonic_balance(out["q_in"], p.Fs, p.KT, p.chi, p.beta, model.k, model.m, model.zeta_v)
@@ -211,22 +224,14 @@ def test_force_driven_driving_point(tmp_path):
     assert env["drive_on"].iloc[-20:].eq(False).all()  # the free decay is not taken for drive
 
 
-def test_force_driven_remote_sensor_gives_the_mode_at_its_own_amplitude(tmp_path):
+def test_force_driven_remote_sensor_gives_the_mode_at_its_own_amplitude(tmp_path, force_driving_point):
     """A sensor near a node (2% of the slug's motion) dominated by other modes' mass line: the envelope
     phase never reaches quadrature, and the swept-mode fit takes the mass line as its residual term and
     a modal constant of either sign. Its resonance and damping are the harmonic balance's at the joint's
     amplitude, the sensor's q_in / 0.02, and its modal constant 0.02 / m."""
-    (tmp_path / "a").mkdir()
     _, model, _ = _force_campaign(tmp_path, response="remote")
-    _force_campaign(tmp_path / "a")
-    from jointcal.io import ingest_campaign, read_run
-    outs = []
-    for folder in (tmp_path, tmp_path / "a"):
-        runs = ingest_campaign(folder)
-        df = read_run(folder / "runs" / "f1.csv")
-        env, meta = envelopes(df, runs.iloc[0].to_dict())
-        outs.append(modal_properties(env, runs.iloc[0].to_dict(), rate_hz_per_s=meta.rate_hz_per_s, record=df))
-    remote, driving = outs
+    remote = _force_measured(tmp_path)[1]
+    driving = force_driving_point[2]
     p = model.iwan
     f_t, z_t = harmonic_balance(remote["q_in"] / 0.02, p.Fs, p.KT, p.chi, p.beta, model.k, model.m, model.zeta_v)
     print(f"\nremote: {remote['f_res_method']} {remote['f_res_hz']:.2f} Hz (truth {float(f_t):.2f}), zeta "

@@ -5,7 +5,8 @@ from .elements import Element, contact_spring, cubic_spring, quadratic_damper
 from .simulate import SimResult, fractional_delay, integrate, simulate
 from .structure import Fixture, MinistackModel, state_space
 from .envelope import SteadyState, steady_state
-from .swept import SweepDrive, quasi_steady, swept_transmissibility
+from .swept import SweepDrive, quasi_steady
+from .swept_integrated import swept_transmissibility
 
 __all__ = [
     "G", "IwanParams", "derived", "backbone", "backbone_stiffness", "dissipation", "force_history",

@@ -19,7 +19,8 @@ from .envelope import steady_state
 from .iwan import IwanParams
 from .simulate import simulate
 from .structure import Fixture, MinistackModel
-from .swept import SweepDrive, quasi_steady, quasi_steady_runs, swept_transmissibility
+from .swept import SweepDrive, quasi_steady, quasi_steady_runs
+from .swept_integrated import swept_transmissibility
 
 __all__ = ["compile_kernels"]
 

@@ -33,7 +33,7 @@ Two evaluations:
   L[dZ_0/domega] = F' A - (dK_z/domega - mu') Z_0 and L[A dZ_0/dA] = F A. Closed form,
   batched over parameter sets; it fails where the steady-state curve is steep (a softening
   peak's bent flank, a fold: L is singular there), and |Z_1| is capped at `CAP` |Z_0|.
-* `swept_transmissibility`: the slow flow integrated by RK4 (`_envelope_kernel.slow_flow`)
+* `swept_transmissibility` (`jointcal.models.swept_integrated`): the slow flow integrated by RK4 (`_envelope_kernel.slow_flow`)
   through the resonance, from the quasi-steady state at x = -`SPAN` (x = (f / f_res - 1) /
   zeta, in sweep order) to x = max(`SPAN`, 1.2 eta) (the ringing has decayed by e^-7
   there), and averaged over each frame's Hann window as the envelopes are (T = <R> / <A>,
@@ -63,12 +63,9 @@ from ..units import G
 from .envelope import _NODES, _WEIGHTS, _amplitudes, _batch_shape, _field, _joint_terms
 from .structure import MinistackModel
 
-__all__ = ["SweepDrive", "quasi_steady", "quasi_steady_runs", "swept_transmissibility", "sweep_eta", "ETA_MIN", "SPAN", "CAP"]
+__all__ = ["SweepDrive", "quasi_steady", "quasi_steady_runs", "sweep_eta", "CAP"]
 
-ETA_MIN = 0.02  # below this eta the first-order quasi-steady envelope is as close as the integrated one
-SPAN = 3.0  # integrated from x = -SPAN through the resonance, half-power half-widths
 CAP = 0.3  # largest first-order correction |Z_1| / |Z_0| (a steep flank or fold breaks the expansion)
-STEP = 0.4  # RK4 step: STEP / (largest |x| + 1) of the decay time 1 / (2 pi f_res zeta)
 
 
 @dataclass(frozen=True)
@@ -267,87 +264,3 @@ def quasi_steady_runs(model: MinistackModel, runs: Sequence[tuple]) -> list[NDAr
     R, _, A = _quasi_steady(model, f_all, base, rate, dlog, "up", segments=segments)
     T = (R / A * _sensor(model, f_all, shape)).reshape(out_shape)
     return [T[..., a:b] for a, b, _ in segments]
-
-
-def swept_transmissibility(model: MinistackModel, drive: SweepDrive, t_s: ArrayLike, *, f_res_hz: float,
-                           zeta: float, span: float = SPAN) -> NDArray[np.complex128]:
-    """Transmissibility at frames t_s of one run, the sweep's transient integrated (one parameter set).
-
-    Parameters
-    ----------
-    model : MinistackModel
-        Scalar fields (one parameter set).
-    drive : SweepDrive
-        The run's measured drive (frame times, frequency, base amplitude, window).
-    t_s : array_like, shape (n,)
-        Frames wanted (centre times, s, within the drive's span).
-    f_res_hz, zeta : float
-        Where the resonance is (the measured one) and its damping ratio: the integration
-        covers x = (f / f_res - 1) / zeta from -span to max(span, 1.2 eta) in sweep order.
-    span : float
-        Half-power half-widths integrated before (and at least after) the resonance.
-
-    Returns
-    -------
-    ndarray of complex, shape (n,)
-        Response over base as the envelopes show it (sensor gain and delay applied).
-
-    Notes
-    -----
-    Runs with eta below `ETA_MIN` take `quasi_steady` at every frame.
-    """
-    t_out = np.atleast_1d(np.asarray(t_s, dtype=float))
-    f_o, b_o, r_o, dl_o = drive.at(t_out)
-    rate = float(np.median(drive.rates[0]))
-    direction = "up" if rate >= 0 else "down"
-    R, _, A = _quasi_steady(model, f_o, b_o, r_o, dl_o, direction)
-    T = (R / A)[0]
-    eta = sweep_eta(rate, f_res_hz, zeta)
-    sign = 1.0 if rate >= 0 else -1.0
-    after = max(span, 1.2 * eta)
-    x = sign * (drive.f_hz / f_res_hz - 1.0) / zeta
-    inside = np.flatnonzero((x >= -span) & (x <= after))
-    L = drive.window_s
-    if eta >= ETA_MIN and inside.size:
-        ka = int(np.searchsorted(drive.t_s, drive.t_s[inside[0]] - L, side="right")) - 1
-        ka = max(ka, 0)
-        t_a = drive.t_s[ka]
-        t_b = min(drive.t_s[-1], drive.t_s[inside[-1]] + L)
-        keep = (t_out - L / 2 >= t_a) & (t_out + L / 2 <= t_b)
-        if keep.any():
-            T[keep] = _integrated(model, drive, t_a, t_b, ka, t_out[keep], direction,
-                                  2 * np.pi * f_res_hz * zeta, max(span, after))
-    return T * _sensor(model, f_o, (1, t_out.size))[0]
-
-
-def _integrated(model: MinistackModel, drive: SweepDrive, t_a: float, t_b: float, ka: int, t_out: NDArray,
-                direction: str, gamma: float, x_max: float) -> NDArray[np.complex128]:
-    """<R> / <A> over the Hann window of each frame t_out, the slow flow integrated over [t_a, t_b]."""
-    r_d, dl_d = drive.rates
-    _, Z, _ = _quasi_steady(model, drive.f_hz[:ka + 1], drive.base_g[:ka + 1], r_d[:ka + 1], dl_d[:ka + 1],
-                            direction)
-    h = STEP / ((x_max + 1.0) * gamma)
-    n = int(np.ceil((t_b - t_a) / h)) + 1
-    h = (t_b - t_a) / (n - 1)
-    th = t_a + 0.5 * h * np.arange(2 * n - 1)
-    f, b, r, dl = drive.at(th)
-    w = 2 * np.pi * f
-    alpha = 2 * np.pi * r
-    A = b * G
-    mu, mu1, mu2, F, F1, F2 = (v[0] for v in _derivs(model, w, (1, w.size)))
-    p0 = np.ascontiguousarray(-mu + 0.5j * alpha * mu2)
-    g0 = np.ascontiguousarray(F * A - 1j * F1 * A * dl - 0.5j * alpha * F2 * A)
-    m1 = np.ascontiguousarray(1j * mu1 + 0j)
-    *scalars, codes, coefs = _joint_terms(model, (1, 1))
-    joint = (*(float(v[0]) for v in scalars), codes, np.ascontiguousarray(coefs[0]))
-    force = np.empty(n, complex)
-    _k.slow_flow(complex(Z[0, -1]), h, w, alpha, p0, g0, m1, *joint, _NODES, _WEIGHTS, force)
-    m = float(_field(model.m, (1, 1))[0])
-    tn, Rn, An = th[::2], -force / m, A[::2]
-    L = drive.window_s
-    out = np.empty(t_out.size, complex)
-    for i, tc in enumerate(t_out):  # the envelopes' periodic Hann window, centred on the frame
-        j0, j1 = np.searchsorted(tn, [tc - L / 2, tc + L / 2])
-        wgt = np.sin(np.pi * (tn[j0:j1] - (tc - L / 2)) / L) ** 2
-        out[i] = np.sum(wgt * Rn[j0:j1]) / np.sum(wgt * An[j0:j1])
-    return out
