@@ -1,9 +1,9 @@
 """Compile the numba kernels once, before the stages that call them run side by side.
 
-The kernels (`_envelope_kernel`, `_integrator`, `_masing`) are compiled on first call and cached by numba next to their
-source (``cache=True``). On a fresh install the cache is empty, and every process that
-calls a kernel before another has written it compiles it again: on the example campaign
-that was about 35 s of one discrepancy job's 70 s. `compile_kernels` calls each kernel
+The kernels (`_envelope_kernel`, `_integrator`, `_masing`) are compiled on first call and
+cached by numba next to their source (``cache=True``). On a fresh install the cache is
+empty, and every process that calls a kernel before another has written it compiles it
+again: on the example campaign that was about 35 s of one discrepancy job's 72 s. `compile_kernels` calls each kernel
 through the same public functions the stages call, with the same argument types, on a
 small model, so one process writes the cache and the others load it.
 """
