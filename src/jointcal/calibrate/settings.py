@@ -30,6 +30,7 @@ from .ga import GAOptions
 from .kind import KINDS
 from .objective import MODELS
 from .space import PARAMS, ParamSpace
+from .._config import config_section
 
 __all__ = ["DEFAULT_BOUNDS", "JOINT", "CalibrateSettings"]
 
@@ -141,11 +142,7 @@ class CalibrateSettings:
         sigma_min, sigma_scale, indpb, tournament, elite, stall_generations, stall_rtol,
         checkpoint_every, seed) sit at the top level of the section.
         """
-        section = dict(section or {})
-        own = {f.name for f in fields(cls)} - {"ga"}
-        unknown = sorted(set(section) - own - _GA_KEYS)
-        if unknown:
-            raise ValueError(f"calibrate: unknown key(s) {', '.join(unknown)}")
+        section = config_section(section, ({f.name for f in fields(cls)} - {"ga"}) | _GA_KEYS, "calibrate")
         ga = GAOptions(**{k: section.pop(k) for k in list(section) if k in _GA_KEYS})
         bounds = {k: [float(x) for x in v] for k, v in dict(section.pop("bounds", {}) or {}).items()}
         return cls(ga=ga, bounds=bounds, **section)

@@ -11,6 +11,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, fields
 from typing import Any
 
+from .._config import config_section
+
 __all__ = ["DesignSettings"]
 
 
@@ -58,10 +60,7 @@ class DesignSettings:
     @classmethod
     def from_config(cls, section: Mapping[str, Any] | None) -> DesignSettings:
         """Build from the config's ``design:`` mapping (missing keys take the defaults)."""
-        section = dict(section or {})
-        unknown = sorted(set(section) - {f.name for f in fields(cls)})
-        if unknown:
-            raise ValueError(f"design: unknown key(s) {', '.join(unknown)}")
+        section = config_section(section, (f.name for f in fields(cls)), "design")
         for key in ("levels", "rate_factors", "directions"):
             if key in section:
                 section[key] = tuple(section[key])

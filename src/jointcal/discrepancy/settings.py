@@ -5,6 +5,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 
 from ..effects import library
+from .._config import config_section
 
 __all__ = ["DiscrepancySettings"]
 
@@ -39,10 +40,7 @@ class DiscrepancySettings:
 
     @classmethod
     def from_config(cls, section: Mapping | None) -> DiscrepancySettings:
-        section = dict(section or {})
-        unknown = sorted(set(section) - {f.name for f in fields(cls)})
-        if unknown:
-            raise ValueError(f"discrepancy: unknown key(s) {', '.join(unknown)}")
+        section = config_section(section, (f.name for f in fields(cls)), "discrepancy")
         for key in ("candidates", "band"):
             if key in section:
                 section[key] = tuple(section[key])

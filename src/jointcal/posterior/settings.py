@@ -11,6 +11,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from typing import Any
 
+from .._config import config_section
+
 __all__ = ["PosteriorSettings"]
 
 
@@ -66,10 +68,7 @@ class PosteriorSettings:
     @classmethod
     def from_config(cls, section: Mapping[str, Any] | None) -> PosteriorSettings:
         """Build from the config's ``posterior:`` mapping (missing keys take the defaults)."""
-        section = dict(section or {})
-        unknown = sorted(set(section) - {f.name for f in fields(cls)})
-        if unknown:
-            raise ValueError(f"posterior: unknown key(s) {', '.join(unknown)}")
+        section = config_section(section, (f.name for f in fields(cls)), "posterior")
         base = cls()
         for name in ("rel_std_floor", "noise_max"):
             if name in section:

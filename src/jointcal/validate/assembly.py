@@ -21,6 +21,7 @@ from ..models import MinistackModel
 from .error import describe_misfit, envelope_error, repeat_scatter
 from .runs import (band_frames, compare_run, draw_transmissibility, full_drive_fraction, measure_pair,
                    reference_column, run_head, time_envelopes)
+from .._config import config_section
 
 __all__ = ["ValidateSettings", "Validation", "validate_runs"]
 
@@ -58,10 +59,7 @@ class ValidateSettings:
     @classmethod
     def from_config(cls, section: Mapping[str, Any] | None) -> ValidateSettings:
         """Build from the config's ``validate:`` mapping (missing keys take the defaults)."""
-        section = dict(section or {})
-        unknown = sorted(set(section) - {f.name for f in fields(cls)})
-        if unknown:
-            raise ValueError(f"validate: unknown key(s) {', '.join(unknown)}")
+        section = config_section(section, (f.name for f in fields(cls)), "validate")
         for key in ("band", "quantiles"):
             if key in section:
                 section[key] = tuple(float(v) for v in section[key])
