@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy import signal
 
 from jointcal.measure.sweepfit import fit_swept_mode
 from jointcal.models import G, IwanParams, MinistackModel, harmonic_balance, simulate
@@ -90,3 +91,36 @@ def test_nan_bursts_are_left_out_not_filled(channel):
     fit = fit_swept_mode(F, acc, fs, f0, zeta, modal_phase=0.0)
     assert fit.f_hz == pytest.approx(f0, rel=3e-4) and fit.zeta == pytest.approx(zeta, rel=0.03)
     assert (fit.fraction_bad > 0) == (channel in ("response", "both"))
+
+
+def test_a_nan_burst_over_the_peak_leaves_the_amplitude_reached():
+    """A 60 ms dropout of the response centred on its peak: the frames within a filter length of it leave
+    the misfit, but q_in is the fitted response's peak over the whole window, the amplitude the mode
+    reached: within 3% of the clean record's band-limited envelope peak |a| G / w0^2 (the largest good
+    sample left put it 9% low)."""
+    f0, zeta, m = 100.0, 0.015, 1.0 / G
+    model = MinistackModel(m=m, k=m * (2 * np.pi * f0) ** 2, zeta_v=zeta)
+    fs = 1024.0
+    F, acc = _force_chirp(model, 70.0, 130.0, 5 * (f0 * zeta) ** 2, fs, 1.0, noise=0.0)
+    sos = signal.butter(4, [0.8 * f0, 1.2 * f0], btype="band", fs=fs, output="sos")
+    env = np.abs(signal.hilbert(signal.sosfiltfilt(sos, acc)))
+    q_truth = env.max() * G / (2 * np.pi * f0) ** 2
+    i_peak = int(np.argmax(env))
+    acc = acc + 0.003 * acc.std() * np.random.default_rng(1).standard_normal(acc.size)
+    acc[i_peak - int(0.03 * fs):i_peak + int(0.03 * fs)] = np.nan
+    fit = fit_swept_mode(F, acc, fs, f0, zeta, modal_phase=0.0)
+    assert fit.fraction_bad > 0.05
+    assert fit.q_in == pytest.approx(q_truth, rel=0.03)
+    assert fit.f_hz == pytest.approx(f0, rel=5e-4) and fit.zeta == pytest.approx(zeta, rel=0.05)
+
+
+def test_a_record_cut_before_its_free_decay_is_said():
+    """A record that ends 50 ms (5 cycles) after the response's peak has lost the free decay that fixes the
+    damping: the fit says so (ringing_end), the whole record does not."""
+    f0, zeta, m = 100.0, 0.015, 1.0 / G
+    model = MinistackModel(m=m, k=m * (2 * np.pi * f0) ** 2, zeta_v=zeta)
+    fs = 1024.0
+    F, acc = _force_chirp(model, 70.0, 130.0, 5 * (f0 * zeta) ** 2, fs, 1.0)
+    assert not fit_swept_mode(F, acc, fs, f0, zeta, modal_phase=0.0).ringing_end
+    end = int(np.argmax(np.abs(acc))) + int(0.05 * fs)
+    assert fit_swept_mode(F[:end], acc[:end], fs, f0, zeta, modal_phase=0.0).ringing_end

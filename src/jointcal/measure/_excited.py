@@ -44,6 +44,7 @@ def excited_readout(env_out, fit, sweep, why, flags, kind, f_bb, z_bb, rate_hz_p
     if sweep is not None:
         q_peak = band_envelope_peak(record, row, kind, sweep.f_hz)
         env_out["sweep_note"] = ""
+        flags += ["sweep_truncated"] * sweep.ringing_end
         return dict(f_res_hz=sweep.f_hz, f_res_method="sweep_fit", q_in=sweep.q_in, zeta_res=sweep.zeta,
                     q_peak_in=q_peak, eta=rate_hz_per_s / (sweep.f_hz * sweep.zeta) ** 2)
     flags.append("sweep_fit_failed")

@@ -198,15 +198,19 @@ def demodulate(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: float
 
 @dataclass(frozen=True)
 class Passage:
-    """The signals cut to the passage through the mode, the samples fitted (`sel`, `win`: all in the
-    window), the integration's start state (z_start, y_start) and the share of `win` left out."""
+    """The signals cut to the passage through the mode, the samples fitted (`sel`, `win`: all good ones in
+    the window), the window itself (`inside`, bad samples too: the model's response is defined there),
+    the integration's start state (z_start, y_start), the share of the window left out and whether the
+    record ended ringing (`ringing_end`: the window runs to the record's last sample, its free decay cut)."""
 
     sig: Signals
     sel: NDArray
     win: NDArray
+    inside: NDArray
     z_start: complex
     y_start: complex
     fraction_bad: float
+    ringing_end: bool = False
 
 
 def passage(sig: Signals, window: float, quiet: float, steps_per_cycle: float) -> Passage:
@@ -232,5 +236,6 @@ def passage(sig: Signals, window: float, quiet: float, steps_per_cycle: float) -
         y_start = complex(1j * (w_loc - W0) * z_start)
     else:
         z_start = y_start = 0j
-    return Passage(sig=cut, sel=sel, win=win, z_start=z_start, y_start=y_start,
-                    fraction_bad=float(1.0 - win.sum() / max(1, inside.sum())))
+    return Passage(sig=cut, sel=sel, win=win, inside=inside, z_start=z_start, y_start=y_start,
+                    fraction_bad=float(1.0 - win.sum() / max(1, inside.sum())),
+                    ringing_end=bool(i1 == sig.Acc.size - 1))

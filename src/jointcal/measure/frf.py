@@ -153,7 +153,8 @@ def record_frf(ref: NDArray, resp_g: NDArray, fs: float, kind: str, f_band: tupl
     tab = tab[keep].reset_index(drop=True)
     f = f[keep]
     X = displacement_ratio(f, (tab["h1_re"] + 1j * tab["h1_im"]).to_numpy(), kind)
-    fit = fit_mode(f, X, f_band, span=span, f_guess=f_guess, modal_phase=MODAL_PHASE[kind])
+    fit = fit_mode(f, X, f_band, span=span, f_guess=f_guess, modal_phase=MODAL_PHASE[kind],
+                   coherence=tab["coherence"].to_numpy())
     y = np.nan_to_num(np.asarray(resp_g, float))
     y = y - np.median(y)
     tail = y[-max(8, min(y.size // 100, int(10 * fs / f_band[0]))):]  # the last 10 cycles (at most 1%)

@@ -74,7 +74,8 @@ def _half_power_zeta(f: NDArray, a: NDArray, ip: int) -> float:
 
 
 def fit_mode(f: NDArray, X: NDArray, f_band: tuple[float, float], *, span: float = 2.0,
-             f_guess: float | None = None, modal_phase: float | None = None) -> ModeFit:
+             f_guess: float | None = None, modal_phase: float | None = None,
+             coherence: NDArray | None = None) -> ModeFit:
     """Single-mode rational fit of the strongest interior peak of X in f_band (or the one at f_guess).
 
     Parameters
@@ -98,6 +99,12 @@ def fit_mode(f: NDArray, X: NDArray, f_band: tuple[float, float], *, span: float
         on the Table 3.2 joint at eta 1-5, the fit's w_n is off the harmonic balance at
         the reached amplitude by up to 1.3%, the measured ratio's quadrature by < 0.2%).
         None (a voltage reference): rotate by the fitted modal constant.
+    coherence : ndarray, optional
+        The band-averaged coherence on the lines f. Where given, the peak is the largest
+        among those with coherence >= 0.5 (the drive's share of the response at least the
+        noise's), when any has: noise divided by w^2 makes peaks of a displacement ratio
+        toward 0 Hz (2% noise on a real 18 Hz beam record put them above the mode's, at
+        coherence < 0.35 against the mode's 0.56-0.67).
 
     Returns
     -------
@@ -110,6 +117,8 @@ def fit_mode(f: NDArray, X: NDArray, f_band: tuple[float, float], *, span: float
     a = np.abs(X[inb])
     if f_guess is None:  # the largest interior peak (a displacement ratio grows without bound toward 0 Hz)
         peaks, _ = signal.find_peaks(a)
+        if coherence is not None and (np.asarray(coherence)[inb][peaks] >= 0.5).any():
+            peaks = peaks[np.asarray(coherence)[inb][peaks] >= 0.5]
         ip = int(peaks[np.argmax(a[peaks])]) if peaks.size else int(np.argmax(a))
     else:
         ip = int(np.argmin(np.abs(f[inb] - f_guess)))

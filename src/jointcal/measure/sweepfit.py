@@ -89,6 +89,8 @@ class SweepFit:
     modal_slope : complex A_1 (same unit): A(w) = A_0 + A_1 (w / W_0 - 1).
     w0 : the frame's frequency W_0, rad/s.
     fraction_bad : share of the fitted window left out for bad samples.
+    ringing_end : the record ended with the response still over `window` of its peak: the free decay
+        that fixes the damping is cut.
     """
 
     f_hz: float
@@ -101,6 +103,7 @@ class SweepFit:
     modal_slope: complex = 0j
     w0: float = float("nan")
     fraction_bad: float = 0.0
+    ringing_end: bool = False
 
     def backbone(self, q: NDArray) -> tuple[NDArray, NDArray]:
         """Natural frequency (Hz) and damping ratio at amplitudes q (in) (fitted over [q_low_in, q_in])."""
@@ -191,11 +194,13 @@ def _result(prob: Problem, best, free: NDArray) -> SweepFit:
     """The fit's resonance and damping at the largest amplitude its response reached, and its backbone."""
     mode, _ = prob.params(best.x, free)
     Z, _ = prob.response(best.x, free)
-    win = prob.ps.win
+    # over the whole window: a bad stretch at the peak leaves the misfit, not the amplitude reached
+    win = prob.ps.inside
     q_top = float(np.abs(Z[win]).max())
     coef = (*(float(v) for v in mode[:6]), float(mode[8]), prob.q_ref, prob.l_lo, prob.l_hi, float(mode[11]))
     fit = SweepFit(f_hz=np.nan, zeta=np.nan, q_in=q_top, q_low_in=float(np.abs(Z[win]).min()),
                    residual=prob.relative(best), coef=coef, modal_constant=complex(mode[6], mode[7]),
-                   modal_slope=complex(mode[9], mode[10]), w0=prob.ps.sig.W0, fraction_bad=prob.ps.fraction_bad)
+                   modal_slope=complex(mode[9], mode[10]), w0=prob.ps.sig.W0, fraction_bad=prob.ps.fraction_bad,
+                   ringing_end=prob.ps.ringing_end)
     f, z = fit.backbone(q_top)
     return SweepFit(**{**fit.__dict__, "f_hz": float(f), "zeta": float(z)})
