@@ -145,7 +145,8 @@ def fit_window(mag: NDArray, ok: NDArray[np.bool_], frac: float, quiet: float,
 @dataclass(frozen=True)
 class Signals:
     """The drive's envelope R (with its rates Rd, Rdd and RK4 midpoints Rm, Rdm) and the response's
-    acceleration envelope Acc in the frame rotating at W0 (rad/s), on the RK4 grid of step h (s)."""
+    acceleration envelope Acc in the frame rotating at W0 (rad/s), on the RK4 grid of step h (s); the
+    record's first sample at step `first` (zeros before it) and the low-pass's reach, `reach` steps."""
 
     R: NDArray
     Rd: NDArray
@@ -156,6 +157,8 @@ class Signals:
     ok: NDArray
     h: float
     W0: float
+    first: int = 0
+    reach: int = 0
 
 
 def demodulate(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: float, cutoff: float,
@@ -193,14 +196,16 @@ def demodulate(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: float
     Rddh = np.gradient(Rdh, h / 2)
     R = Rh[::2]
     Acc, bad_A = Acc[::2 * half][:R.size], bad_A[::2 * half][:R.size]
-    return Signals(R=R, Rd=Rdh[::2], Rdd=Rddh[::2], Rm=Rh[1::2], Rdm=Rdh[1::2], Acc=Acc, ok=~bad_A, h=h, W0=W0)
+    return Signals(R=R, Rd=Rdh[::2], Rdd=Rddh[::2], Rm=Rh[1::2], Rdm=Rdh[1::2], Acc=Acc, ok=~bad_A, h=h, W0=W0,
+                   first=int(round(margin * up / (2 * half))), reach=int(np.ceil(margin * up / (2 * half))))
 
 
 @dataclass(frozen=True)
 class Passage:
     """The signals cut to the passage through the mode, the samples fitted (`sel`, `win`: all good ones in
     the window), the window itself (`inside`, bad samples too: the model's response is defined there),
-    the integration's start state (z_start, y_start), the share of the window left out and whether the
+    the integration's start state (z_start, y_start; `free_start`: the record began with the mode
+    already moving, so the state is fitted from there), the share of the window left out and whether the
     record ended ringing (`ringing_end`: the window runs to the record's last sample, its free decay cut)."""
 
     sig: Signals
@@ -211,12 +216,21 @@ class Passage:
     y_start: complex
     fraction_bad: float
     ringing_end: bool = False
+    free_start: bool = False
 
 
 def passage(sig: Signals, window: float, quiet: float, steps_per_cycle: float) -> Passage:
     """The stretch fitted (`jointcal.measure._rotating.fit_window`) and the forced state it starts from."""
     mag = np.abs(sig.Acc)
     i_start, i0, i1 = fit_window(mag, sig.ok, window, quiet)
+    # a record that begins with the mode already moving (cut from a longer run, or the drive on before
+    # the recording): its state at the start is not rest; the integration starts a low-pass reach into
+    # the record (past the zeros' smear) from a fitted state (`jointcal.measure._sweep_problem`)
+    head = min(sig.first + sig.reach, i0)
+    free_start = bool(i_start == 0 and head > 0 and sig.ok[head]
+                      and mag[head] > quiet * np.max(mag[sig.ok], initial=0.0))
+    if free_start:
+        i_start = head
     R, Rd, Rdd, Acc, ok, mag = (x[i_start:i1 + 1] for x in (sig.R, sig.Rd, sig.Rdd, sig.Acc, sig.ok, mag))
     cut = Signals(R=R, Rd=Rd, Rdd=Rdd, Rm=sig.Rm[i_start:i1], Rdm=sig.Rdm[i_start:i1], Acc=Acc, ok=ok, h=sig.h,
                    W0=sig.W0)
@@ -238,4 +252,4 @@ def passage(sig: Signals, window: float, quiet: float, steps_per_cycle: float) -
         z_start = y_start = 0j
     return Passage(sig=cut, sel=sel, win=win, inside=inside, z_start=z_start, y_start=y_start,
                     fraction_bad=float(1.0 - win.sum() / max(1, inside.sum())),
-                    ringing_end=bool(i1 == sig.Acc.size - 1))
+                    ringing_end=bool(i1 == sig.Acc.size - 1), free_start=free_start)

@@ -17,19 +17,23 @@ from ._rotating import Passage, rotating_mode
 __all__ = ["Problem", "fit_from_starts", "earned_terms"]
 
 
-X_SCALE = np.array([1e-3, 0.1, 0.01, 0.01, 0.2, 0.2, 0.1, 0.1, 0.2, 0.5, 0.5, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01])
-LOWER, UPPER = np.full(18, -np.inf), np.full(18, np.inf)
+NP = 22  # parameters: the mode's 18, and its start state's 4 where the record begins in motion
+X_SCALE = np.array([1e-3, 0.1, 0.01, 0.01, 0.2, 0.2, 0.1, 0.1, 0.2, 0.5, 0.5, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01,
+                    0.05, 0.05, 0.05, 0.05])
+LOWER, UPPER = np.full(NP, -np.inf), np.full(NP, np.inf)
 LOWER[8], UPPER[8] = 0.0, 1.0  # phi, the hysteretic share of the damping
 
 
 @dataclass(frozen=True)
 class Problem:
-    """The least-squares problem of one passage: 18 scaled parameters (those in a `free` set fitted)
+    """The least-squares problem of one passage: 22 scaled parameters (those in a `free` set fitted)
     map to the mode (`params`), whose response is compared with the measured one (`misfit`).
 
     p[0], p[1]: ln(Omega_ref / W0) and ln(D_ref / (2 zeta0 W0)); p[2:4], p[15]: ln Omega^2's linear,
     quadratic and cubic terms in L; p[4:6]: ln D's; p[6:8]: the modal constant over `a_abs`; p[8]: phi;
-    p[9:11]: the modal constant's slope; p[11:15], p[16:18]: the residual terms over `b_abs`.
+    p[9:11]: the modal constant's slope; p[11:15], p[16:18]: the residual terms over `b_abs`;
+    p[18:22] (a passage with `free_start`): the start state's correction, Z over q_ref and Z' over
+    q_ref W0, real and imaginary parts.
     """
 
     ps: Passage
@@ -65,7 +69,8 @@ class Problem:
                    l_hi=float(np.log(1.5)), a_abs=2 * zeta0 * peak / r_abs,  # |A| of a steady resonance:
                    b_abs=peak / r_abs, fixed=fixed,                          # |Acc| = |A| |R| / (2 zeta)
                    rot=np.exp(1j * modal_phase) if fixed else 1.0,
-                   free_all=np.array([0, 1, 2, 3, 4, 5, 6, 8, 11, 13, 15, 16] if fixed else list(range(18))),
+                   free_all=np.array(([0, 1, 2, 3, 4, 5, 6, 8, 11, 13, 15, 16] if fixed else list(range(18)))
+                                     + ([18, 19, 20, 21] if ps.free_start else [])),
                    weight=ridge * np.sqrt(sel.sum()), ridge_terms=(residual_ridge, curv),
                    # the residual terms' basis: (w / W0 - 1)^k R for k = 0, 1, 2 in the frame (w R -> W0 R - i R')
                    residual_basis=np.stack([sig.R, -1j * sig.Rd / W0, -sig.Rdd / W0**2], axis=1),
@@ -73,7 +78,7 @@ class Problem:
 
     def params(self, pf: NDArray, free: NDArray) -> tuple[NDArray, NDArray]:
         """The mode's coefficients (`jointcal.measure._rotating.rotating_mode`'s p) and the residual terms."""
-        p = np.zeros(18)
+        p = np.zeros(NP)
         p[free] = pf
         W0, a_abs, zeta0 = self.ps.sig.W0, self.a_abs, self.zeta0
         a = p[6] * self.rot if self.fixed else p[6] + 1j * p[7]
@@ -85,8 +90,12 @@ class Problem:
         """The mode's displacement envelope Z (in) and acceleration envelope with the residual terms (in/s^2)."""
         mode, b = self.params(pf, free)
         s, ps = self.ps.sig, self.ps
-        Z, acc = rotating_mode(s.R, s.Rd, s.Rm, s.Rdm, s.W0, s.h, mode, self.q_ref, self.l_lo, self.l_hi,
-                               ps.z_start, ps.y_start)
+        z0, y0 = ps.z_start, ps.y_start
+        if ps.free_start:
+            p = np.zeros(NP)
+            p[free] = pf
+            z0, y0 = z0 + self.q_ref * complex(p[18], p[19]), y0 + self.q_ref * s.W0 * complex(p[20], p[21])
+        Z, acc = rotating_mode(s.R, s.Rd, s.Rm, s.Rdm, s.W0, s.h, mode, self.q_ref, self.l_lo, self.l_hi, z0, y0)
         return Z, acc + self.residual_basis @ b  # residual terms: the other modes' mass or stiffness lines
 
     def misfit(self, pf: NDArray, free: NDArray) -> NDArray:
@@ -94,7 +103,7 @@ class Problem:
         with np.errstate(all="ignore"):  # a trial step may diverge: a large misfit, not a warning
             res = (self.response(pf, free)[1] - self.ps.sig.Acc)[self.ps.sel] / self.peak
         res = np.where(np.isfinite(res) & (np.abs(res) < 1e3), res, 1e3)
-        p = np.zeros(18)
+        p = np.zeros(NP)
         p[free] = pf
         residual_ridge, curv = self.ridge_terms
         # a ridge on the nuisance terms (the modal constant's slope relative to it, the residual terms
@@ -102,7 +111,7 @@ class Problem:
         # cannot tell a feedthrough from the mode's response while the drive passes)
         nuisance = np.concatenate([p[9:11] / max(np.hypot(p[6], p[7]), 1e-12),
                                    residual_ridge * np.concatenate([p[11:15], [0.0], p[16:18]])])
-        nuisance = nuisance[free[free >= 9] - 9]
+        nuisance = nuisance[free[(free >= 9) & (free < 18)] - 9]
         curvature = curv * p[5] * self.l_lo**2  # the damping's quadratic term's change over the window
         return np.concatenate([res.real, res.imag, self.weight * nuisance, [self.weight * curvature]])
 
@@ -122,7 +131,7 @@ def fit_from_starts(prob: Problem, free: NDArray, f0: float, zeta0: float):
     best, rel = None, np.inf
     for f_s, z_s, a_s, b0_s, b1_s, b2_s in _starts(s.R, s.Rd, s.Rm, s.Rdm, s.Rdd, s.Acc, prob.ps.sel, s.h, s.W0, f0,
                                                    zeta0, prob.fixed, prob.rot):
-        p0 = np.zeros(18)
+        p0 = np.zeros(NP)
         p0[:2] = np.log(f_s / f0), np.log(z_s * f_s / (zeta0 * f0))
         a_s = a_s / prob.a_abs / prob.rot
         p0[6], p0[7], p0[8] = a_s.real, (0.0 if prob.fixed else a_s.imag), 0.5
@@ -152,7 +161,7 @@ def earned_terms(prob: Problem, best, free: NDArray, frequency_curvature: str, e
     n_eff = prob.n_res / 2
 
     def refit(sol, old, new):
-        p_now = np.zeros(18)
+        p_now = np.zeros(NP)
         p_now[old] = sol.x
         return prob.solve(p_now[new], new, 60)
 
