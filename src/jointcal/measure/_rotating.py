@@ -19,7 +19,8 @@ from scipy import signal
 
 from ..units import G
 
-__all__ = ["rotating_mode", "baseband", "dilate", "bridge", "fit_window", "Signals", "demodulate", "Passage", "passage"]
+__all__ = ["rotating_mode", "baseband", "dilate", "bridge", "fit_window", "Signals", "demodulate", "Passage", "passage",
+           "head_end"]
 
 
 @numba.njit(cache=True)
@@ -200,12 +201,17 @@ def demodulate(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: float
                    first=int(round(margin * up / (2 * half))), reach=int(np.ceil(margin * up / (2 * half))))
 
 
+def head_end(sig: Signals) -> int:
+    """The step a low-pass reach into the record (past the smear of the zeros before it)."""
+    return min(sig.first + sig.reach, sig.R.size - 1)
+
+
 @dataclass(frozen=True)
 class Passage:
     """The signals cut to the passage through the mode, the samples fitted (`sel`, `win`: all good ones in
     the window), the window itself (`inside`, bad samples too: the model's response is defined there),
-    the integration's start state (z_start, y_start; `free_start`: the record began with the mode
-    already moving, so the state is fitted from there), the share of the window left out and whether the
+    the integration's start state (z_start, y_start, at step `i_start` of the signals; `free_start`: the
+    record began with the mode already moving, so the state is fitted from there), the share of the window left out and whether the
     record ended ringing (`ringing_end`: the window runs to the record's last sample, its free decay cut)."""
 
     sig: Signals
@@ -217,23 +223,24 @@ class Passage:
     fraction_bad: float
     ringing_end: bool = False
     free_start: bool = False
+    i_start: int = 0
 
 
-def passage(sig: Signals, window: float, quiet: float, steps_per_cycle: float) -> Passage:
-    """The stretch fitted (`jointcal.measure._rotating.fit_window`) and the forced state it starts from."""
+def passage(sig: Signals, window: float, quiet: float, steps_per_cycle: float, free_start: bool = False) -> Passage:
+    """The stretch fitted (`jointcal.measure._rotating.fit_window`) and the forced state it starts from.
+
+    free_start: where the integration would start from rest at the record's start, start it a low-pass
+    reach into the record (past the smear of the zeros before it) from a state to be fitted instead
+    (a record that begins with the mode already moving: `jointcal.measure.sweepfit`).
+    """
     mag = np.abs(sig.Acc)
     i_start, i0, i1 = fit_window(mag, sig.ok, window, quiet)
-    # a record that begins with the mode already moving (cut from a longer run, or the drive on before
-    # the recording): its state at the start is not rest; the integration starts a low-pass reach into
-    # the record (past the zeros' smear) from a fitted state (`jointcal.measure._sweep_problem`)
-    head = min(sig.first + sig.reach, i0)
-    free_start = bool(i_start == 0 and head > 0 and sig.ok[head]
-                      and mag[head] > quiet * np.max(mag[sig.ok], initial=0.0))
-    if free_start:
-        i_start = head
+    free_start = bool(free_start and i_start == 0 and 0 < head_end(sig) < i1 and sig.ok[head_end(sig)])
+    if free_start:  # the window's samples before it (in the zeros' smear) are left out
+        i_start = head_end(sig)
     R, Rd, Rdd, Acc, ok, mag = (x[i_start:i1 + 1] for x in (sig.R, sig.Rd, sig.Rdd, sig.Acc, sig.ok, mag))
     cut = Signals(R=R, Rd=Rd, Rdd=Rdd, Rm=sig.Rm[i_start:i1], Rdm=sig.Rdm[i_start:i1], Acc=Acc, ok=ok, h=sig.h,
-                   W0=sig.W0)
+                   W0=sig.W0, first=max(sig.first - i_start, 0), reach=sig.reach)
     inside = np.arange(mag.size) >= i0 - i_start
     win = ok & inside
     # the misfit on every third step (2 samples per cycle at f0): the envelopes are band-limited below
@@ -252,4 +259,5 @@ def passage(sig: Signals, window: float, quiet: float, steps_per_cycle: float) -
         z_start = y_start = 0j
     return Passage(sig=cut, sel=sel, win=win, inside=inside, z_start=z_start, y_start=y_start,
                     fraction_bad=float(1.0 - win.sum() / max(1, inside.sum())),
-                    ringing_end=bool(i1 == sig.Acc.size - 1), free_start=free_start)
+                    ringing_end=bool(i1 == sig.Acc.size - 1), free_start=free_start,
+                    i_start=int(i_start))

@@ -56,6 +56,12 @@ Bad samples (NaN or inf) in either channel are left out: the response's frames w
 filter length of them leave the misfit, and the drive's demodulated envelope is bridged
 across them as the swept sine it is (a quadratic phase and a log-linear magnitude fitted on
 both sides).
+
+A fast chirp's integration starts from rest at the record's start (the sweep's start). A record
+that begins with the mode already moving (cut from a longer run, or the drive on before the
+recording) contradicts that: where the fit from rest misses the response there by more than
+`quiet` of its peak, the run is fitted again from a low-pass reach into the record, from a start
+state fitted with the mode, and that fit is kept where the information criterion asks for it.
 """
 from __future__ import annotations
 
@@ -64,7 +70,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ._rotating import baseband, demodulate, passage
+from ._rotating import baseband, demodulate, head_end, passage
 from ._sweep_problem import Problem, earned_terms, fit_from_starts
 
 __all__ = ["SweepFit", "baseband", "fit_swept_mode"]
@@ -91,6 +97,9 @@ class SweepFit:
     fraction_bad : share of the fitted window left out for bad samples.
     ringing_end : the record ended with the response still over `window` of its peak: the free decay
         that fixes the damping is cut.
+    start_fitted : the record began with the mode already moving (the fit from rest missed the
+        response at the record's start by more than `quiet` of its peak), and the fit kept is the one
+        from a fitted state a low-pass reach in.
     """
 
     f_hz: float
@@ -104,6 +113,7 @@ class SweepFit:
     w0: float = float("nan")
     fraction_bad: float = 0.0
     ringing_end: bool = False
+    start_fitted: bool = False
 
     def backbone(self, q: NDArray) -> tuple[NDArray, NDArray]:
         """Natural frequency (Hz) and damping ratio at amplitudes q (in) (fitted over [q_low_in, q_in])."""
@@ -182,12 +192,33 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
         When the record holds no drive or no response, or too few good samples.
     """
     sig = demodulate(ref, resp_g, fs, f0, zeta0, cutoff, steps_per_cycle)
-    ps = passage(sig, window, quiet, steps_per_cycle)
-    prob = Problem.build(ps, f0, zeta0, window, modal_phase, ridge, curv, residual_ridge)
-    free = prob.free_all[~np.isin(prob.free_all, (3, 15))]  # ln Omega^2 linear in L first; its curvature if asked
-    best = fit_from_starts(prob, free, f0, zeta0)
-    best, free = earned_terms(prob, best, free, frequency_curvature, earn)
-    return _result(prob, best, free)
+
+    def fit(free_start):
+        prob = Problem.build(passage(sig, window, quiet, steps_per_cycle, free_start), f0, zeta0, window, modal_phase,
+                             ridge, curv, residual_ridge)
+        free = prob.free_all[~np.isin(prob.free_all, (3, 15))]  # ln Omega^2 linear in L first; its curvature if asked
+        best = fit_from_starts(prob, free, f0, zeta0)
+        return (prob, *earned_terms(prob, best, free, frequency_curvature, earn))
+
+    rest = fit(False)
+    if not _starts_moving(*rest, quiet):
+        return _result(*rest)
+    moving = fit(True)  # the record began with the mode already moving: its start state fitted
+    n_eff = moving[0].n_res / 2
+    ratio = (rest[0].relative(rest[1]) / moving[0].relative(moving[1])) ** 2  # the misfits' sums of squares
+    return _result(*(moving if n_eff * np.log(ratio) > 4 * np.log(n_eff) else rest))
+
+
+def _starts_moving(prob: Problem, best, free: NDArray, quiet: float) -> bool:
+    """Whether the fit from rest at the record's start misses the response there, within a low-pass
+    reach, by more than `quiet` of its peak: the record began with the mode already moving."""
+    ps = prob.ps
+    if ps.i_start != 0 or ps.free_start or ps.sig.reach == 0:
+        return False
+    head = slice(ps.sig.first, head_end(ps.sig) + 1)
+    _, acc = prob.response(best.x, free)
+    gap = np.abs(acc[head] - ps.sig.Acc[head])[ps.sig.ok[head]]
+    return bool(gap.size and gap.max() > quiet * prob.peak)
 
 
 def _result(prob: Problem, best, free: NDArray) -> SweepFit:
@@ -201,6 +232,6 @@ def _result(prob: Problem, best, free: NDArray) -> SweepFit:
     fit = SweepFit(f_hz=np.nan, zeta=np.nan, q_in=q_top, q_low_in=float(np.abs(Z[win]).min()),
                    residual=prob.relative(best), coef=coef, modal_constant=complex(mode[6], mode[7]),
                    modal_slope=complex(mode[9], mode[10]), w0=prob.ps.sig.W0, fraction_bad=prob.ps.fraction_bad,
-                   ringing_end=prob.ps.ringing_end)
+                   ringing_end=prob.ps.ringing_end, start_fitted=prob.ps.free_start)
     f, z = fit.backbone(q_top)
     return SweepFit(**{**fit.__dict__, "f_hz": float(f), "zeta": float(z)})
