@@ -210,9 +210,10 @@ def head_end(sig: Signals) -> int:
 class Passage:
     """The signals cut to the passage through the mode, the samples fitted (`sel`, `win`: all good ones in
     the window), the window itself (`inside`, bad samples too: the model's response is defined there),
-    the integration's start state (z_start, y_start, at step `i_start` of the signals; `free_start`: the
-    record began with the mode already moving, so the state is fitted from there), the share of the window left out and whether the
-    record ended ringing (`ringing_end`: the window runs to the record's last sample, its free decay cut)."""
+    the integration's start state (z_start, y_start, at step `i_start` of the signals; `free_start`:
+    the record began with the mode already moving, so the state is fitted from there), the share of
+    the window left out and whether the record ended ringing (`ringing_end`: the window runs to the
+    record's last sample, its free decay cut)."""
 
     sig: Signals
     sel: NDArray
