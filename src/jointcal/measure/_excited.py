@@ -43,7 +43,8 @@ def excited_readout(env_out, fit, sweep, why, flags, kind, f_bb, z_bb, rate_hz_p
         env_out["zeta_phase_resonance"] = zeta_at_quadrature(fit) * (G / mass_lbf) / fit.modal_constant
     if sweep is not None:
         q_peak = band_envelope_peak(record, row, kind, sweep.f_hz)
-        env_out["sweep_note"] = ""
+        env_out["sweep_note"] = ("the record began with the mode already moving: its start state fitted"
+                                 if sweep.start_fitted else "")
         flags += ["sweep_truncated"] * sweep.ringing_end
         return dict(f_res_hz=sweep.f_hz, f_res_method="sweep_fit", q_in=sweep.q_in, zeta_res=sweep.zeta,
                     q_peak_in=q_peak, eta=rate_hz_per_s / (sweep.f_hz * sweep.zeta) ** 2)

@@ -117,8 +117,9 @@ def fit_mode(f: NDArray, X: NDArray, f_band: tuple[float, float], *, span: float
     a = np.abs(X[inb])
     if f_guess is None:  # the largest interior peak (a displacement ratio grows without bound toward 0 Hz)
         peaks, _ = signal.find_peaks(a)
-        if coherence is not None and (np.asarray(coherence)[inb][peaks] >= 0.5).any():
-            peaks = peaks[np.asarray(coherence)[inb][peaks] >= 0.5]
+        coherent = None if coherence is None else np.asarray(coherence)[inb][peaks] >= 0.5
+        if coherent is not None and coherent.any():
+            peaks = peaks[coherent]
         ip = int(peaks[np.argmax(a[peaks])]) if peaks.size else int(np.argmax(a))
     else:
         ip = int(np.argmin(np.abs(f[inb] - f_guess)))
