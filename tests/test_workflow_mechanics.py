@@ -282,3 +282,39 @@ def test_failed_rerun_removes_the_downstream_outputs_it_could_not_remake(touched
     assert not (results / "modal" / "modal_properties.csv").exists()  # the failed job's own (Snakemake's doing)
     assert all(p.is_file() for p in upstream)  # up to date: kept
     assert (results / "logs" / "modal.log").is_file()
+
+
+def _settings(node, path=()):
+    """Every leaf setting of a config (path, value), a list being one setting."""
+    if isinstance(node, dict) and node:
+        for k, v in node.items():
+            yield from _settings(v, (*path, k))
+    else:
+        yield path, node
+
+
+def test_every_setting_given_on_the_command_line_as_the_readme_shows_is_read_as_its_value():
+    """Each setting of config.yaml given as ``--config 'section={key: value}'`` (Snakemake's own parser,
+    which leaves nested values as text) is read back as the value the config file gives, or stops in one
+    sentence; a list-or-null setting (modal.mode_hz) takes a number, a list and null."""
+    import yaml
+    from snakemake.cli import parse_config
+    from snakemake.utils import update_config
+
+    defaults = yaml.safe_load((REPO / "workflow" / "config" / "config.yaml").read_text())
+    cases = [(p, v) for p, v in _settings(defaults)]
+    cases += [(("modal", "mode_hz"), 95.0), (("modal", "mode_hz"), [18.6, 95.0]), (("modal", "mode_hz"), None)]
+    assert len(cases) > 40  # the walk reached the nested sections
+    for path, value in cases:
+        text = yaml.safe_dump(value, default_flow_style=True).strip().removesuffix("...").strip()
+        for key in reversed(path[1:]):
+            text = f"{{{key}: {text}}}"
+        config = yaml.safe_load((REPO / "workflow" / "config" / "config.yaml").read_text())
+        update_config(config, parse_config([f"{path[0]}={text}"]))
+        assert config_problem(config, SCHEMA) is None, (path, text)
+        got = config
+        for key in path:
+            got = got[key]
+        assert got == value, (path, text, got)
+    msg = config_problem({"modal": {"mode_hz": ["95", "high"]}}, SCHEMA)
+    assert msg is not None and "\n" not in msg and "modal.mode_hz" in msg

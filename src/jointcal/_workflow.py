@@ -130,18 +130,43 @@ def _resolve(schema: Mapping[str, Any], root: Mapping[str, Any]) -> Mapping[str,
 
 
 _TYPES = {"number": (int, float), "integer": (int,), "boolean": (bool,), "array": (list,), "object": (dict,)}
+_NULL_TEXT = ("null", "none", "~", "")
+_UNPARSED = object()
 
 
-def _coerce(value: Any, schema: Mapping[str, Any]) -> Any:
-    """A text value (as ``--config`` leaves nested ones) parsed to the schema's type, if it parses as one."""
+def _parse(text: str, want: str) -> Any:
+    """`text` read as JSON-schema type `want`, or `_UNPARSED`."""
+    if want == "null":
+        return None if text.strip().lower() in _NULL_TEXT else _UNPARSED
+    if want not in _TYPES:
+        return _UNPARSED
+    try:  # float() reads 1e-3, which YAML 1.1 (PyYAML) leaves as text
+        parsed = int(text) if want == "integer" else float(text) if want == "number" else yaml.safe_load(text)
+    except (ValueError, yaml.YAMLError):
+        return _UNPARSED
+    ok = isinstance(parsed, _TYPES[want]) and not (want != "boolean" and isinstance(parsed, bool))
+    return parsed if ok else _UNPARSED
+
+
+def _coerce(value: Any, schema: Mapping[str, Any], root: Mapping[str, Any]) -> Any:
+    """A text value (as ``--config`` leaves nested ones) parsed to the schema's type, if it parses as one.
+
+    The schema's ``type`` may be one name or a list of them (``["number", "null"]``), tried in order;
+    an array's items are converted by the items' own schema.
+    """
     want = schema.get("type")
-    if isinstance(value, str) and want in _TYPES:
-        try:  # float() reads 1e-3, which YAML 1.1 (PyYAML) leaves as text
-            parsed = int(value) if want == "integer" else float(value) if want == "number" else yaml.safe_load(value)
-        except (ValueError, yaml.YAMLError):
+    wants = [want] if isinstance(want, str) else [w for w in (want or []) if isinstance(w, str)]
+    if isinstance(value, str):
+        for w in wants:
+            parsed = _parse(value, w)
+            if parsed is not _UNPARSED:
+                value = parsed
+                break
+        else:
             return value
-        ok = isinstance(parsed, _TYPES[want]) and not (want != "boolean" and isinstance(parsed, bool))
-        return parsed if ok else value
+    if isinstance(value, list) and "array" in wants and isinstance(schema.get("items"), Mapping):
+        items = _resolve(schema["items"], root)
+        return [_coerce(v, items, root) for v in value]
     return value
 
 
@@ -177,9 +202,7 @@ def config_problem(config: MutableMapping[str, Any], schema_file: str | os.PathL
                 return (f"config key '{where}' is not a setting of this workflow; {hint} "
                         f"(all settings: workflow/config/config.yaml)")
             sub = _resolve(props[key], root)
-            cfg[key] = value = _coerce(cfg[key], sub)
-            if isinstance(value, list) and isinstance(sub.get("items"), Mapping):
-                cfg[key] = [_coerce(v, _resolve(sub["items"], root)) for v in value]
+            cfg[key] = value = _coerce(cfg[key], sub, root)
             if isinstance(value, MutableMapping) and "properties" in sub:
                 found = walk(value, sub, f"{where}.")
                 if found:
