@@ -46,6 +46,7 @@ rule all:
     default_target: True
     input:
         INGEST / "runs.csv",
+        KERNELS,  # compiled beside the modal stage, before the jobs its table names
         rules.modal.input,
         rules.calibrate.input,
         rules.posterior.input,

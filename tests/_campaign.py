@@ -66,3 +66,12 @@ def workflow_copy(tmp_path: Path) -> Path:
     for folder in ("workflow", "profiles"):
         shutil.copytree(REPO / folder, work / folder, ignore=shutil.ignore_patterns("__pycache__"))
     return work
+
+
+def unit(results: Path, assembly: str) -> str:
+    """The mode of an assembly that holds one (its folder under each per-unit stage: ``<stage>/<assembly>/<mode>``)."""
+    from jointcal._workflow import modal_units
+
+    modes = [m for a, m in modal_units(results / "modal" / "modal_properties.csv") if a == assembly]
+    assert len(modes) == 1, modes
+    return modes[0]

@@ -32,20 +32,20 @@ def test_a_voltage_driven_real_campaign_runs_end_to_end_with_the_default_config(
     res = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", "--config", f"raw_data={REAL}",
                           f"results={out}"], cwd=work, capture_output=True, text=True, timeout=1800)
     assert res.returncode == 0, res.stderr[-3000:]
-    best = json.loads((out / "calibration" / "bert_5Nm" / "ga_best.json").read_text())
+    best = json.loads((out / "calibration" / "bert_5Nm" / "m18" / "ga_best.json").read_text())
     assert best["model_kind"] == "modal" and best["excitation"] == "voltage" and best["per_unit_modal_mass"]
     assert best["m"] == 1.0
     assert all(best["bounds"][p] != DEFAULT_BOUNDS[p] for p in ("Fs", "KT", "k"))  # from the data
     modal = pd.read_csv(out / "modal" / "modal_properties.csv")
     assert (modal["f_res_method"] == "sweep_fit").all()
-    curve = pd.read_csv(out / "calibration" / "bert_5Nm" / "model_curves.csv")
+    curve = pd.read_csv(out / "calibration" / "bert_5Nm" / "m18" / "model_curves.csv")
     curve = curve[curve["model"] == best["model"]]
     f_model = np.interp(np.log(modal["q_in"]), np.log(curve["q_in"]), curve["f_hz"])
     err = f_model / modal["f_res_hz"] - 1
     print("\ncalibrated curve vs each run's (q_in, f_res_hz):", ", ".join(f"{100 * e:+.3f}%" for e in err))
     assert np.abs(err).max() < 2e-3
-    summary = json.loads((out / "validation" / "bert_5Nm" / "summary.json").read_text())
+    summary = json.loads((out / "validation" / "bert_5Nm" / "m18" / "summary.json").read_text())
     assert np.isfinite(summary["E"]) and "modal constant" in summary["words"]
-    assert any((out / "validation" / "bert_5Nm" / "envelopes" / "traces").glob("*.csv"))
-    assert "per unit modal mass" in (out / "posterior" / "bert_5Nm" / "constraints.txt").read_text()
+    assert any((out / "validation" / "bert_5Nm" / "m18" / "envelopes" / "traces").glob("*.csv"))
+    assert "per unit modal mass" in (out / "posterior" / "bert_5Nm" / "m18" / "constraints.txt").read_text()
     assert not (out / "discrepancy").exists()  # the base-driven rig's library is not run on a voltage campaign

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 import yaml
-from _campaign import REPO, edit_run, workflow_copy
+from _campaign import REPO, edit_run, workflow_copy, unit
 
 pytestmark = pytest.mark.slow
 
@@ -73,12 +73,12 @@ def test_validate_stage_reruns_only_itself_on_a_config_edit(small_run, small_cam
     """`snakemake validate` on the small campaign; then -n: nothing; an edit of validate: only it."""
     work, out, res = small_run
     assert res.returncode == 0, res.stderr
-    summary = json.loads((out / "validation" / "first" / "summary.json").read_text())
+    summary = json.loads((out / "validation" / "first" / unit(out, "first") / "summary.json").read_text())
     assert np.isfinite(summary["E"]) and "peak response" in summary["words"]
-    metrics = pd.read_csv(out / "validation" / "first" / "metrics.csv")
+    metrics = pd.read_csv(out / "validation" / "first" / unit(out, "first") / "metrics.csv")
     assert len(metrics) == 5 and (metrics["n_frames"] > 0).all()
     assert (out / "figures" / "fig3_11_validation.png").stat().st_size > 10_000
-    assert "validation envelope error E" in (out / "logs" / "validate" / "first.log").read_text()
+    assert "validation envelope error E" in (out / "logs" / "validate" / "first" / f"{unit(out, 'first')}.log").read_text()
     assert "Nothing to be done" in _again(small_run, small_campaign, "-n", "validate").stdout
     edited = {**SMALL, "validate": {"n_draws": 3}}
     (work / "small.yaml").write_text(yaml.safe_dump(edited))
@@ -103,10 +103,10 @@ def test_discrepancy_target_runs_that_stage_alone_on_top(small_run, small_campai
     assert res.returncode == 0, res.stderr
     ran = set(re.findall(r"rule (\w+):", res.stdout + res.stderr))
     assert ran == {"discrepancy_assembly", "discrepancy_table", "discrepancy"}, ran
-    d = json.loads((out / "discrepancy" / "first" / "diagnosis.json").read_text())
+    d = json.loads((out / "discrepancy" / "first" / unit(out, "first") / "diagnosis.json").read_text())
     assert d["effect"] in {"sensor_gain", "channel_delay", "none", "unexplained"}
     assert np.isfinite(d["metric_before"]) and np.isfinite(d["metric_after"]) and "emcee" in d["recalibrated"]["method"]
-    assert (out / "discrepancy" / "first" / "diagnosis.md").read_text().startswith("# Discrepancy diagnosis")
+    assert (out / "discrepancy" / "first" / unit(out, "first") / "diagnosis.md").read_text().startswith("# Discrepancy diagnosis")
     assert "<table>" in (out / "discrepancy" / "table_3_2_corrected.html").read_text()
 
 
@@ -153,18 +153,18 @@ def test_default_config_runs_on_the_example_campaign(workdir, tmp_path):
     assert len(modal) == 24 and modal["f_res_hz"].notna().all()
     assert (out / "figures" / "fig3_5_envelopes.png").is_file()
     for asm in ("first", "reassembly"):
-        assert (out / "calibration" / asm / "ga_best.json").is_file()
-        assert (out / "posterior" / asm / "summary.csv").is_file()
+        assert (out / "calibration" / asm / unit(out, asm) / "ga_best.json").is_file()
+        assert (out / "posterior" / asm / unit(out, asm) / "summary.csv").is_file()
     assert (out / "posterior" / "table_3_2.md").is_file()
     assert (out / "figures" / "fig3_11_validation.png").is_file()
     for asm in ("first", "reassembly"):
-        d = json.loads((out / "discrepancy" / asm / "diagnosis.json").read_text())
+        d = json.loads((out / "discrepancy" / asm / unit(out, asm) / "diagnosis.json").read_text())
         assert d["effect"] == "fixture_flexibility" and d["metric_after"] < 0.3 * d["metric_before"]
     for asm in ("first", "reassembly"):  # the design stage: a next test within the shaker limit, its predictions
-        nt = json.loads((out / "design" / asm / "next_test.json").read_text())
+        nt = json.loads((out / "design" / asm / unit(out, asm) / "next_test.json").read_text())
         assert {"level_g", "direction", "sweep_rate_hz_per_s"} <= set(nt["recommended"])
         assert nt["recommended"]["level_g"] <= 100.0 and {"Fs", "KT", "KT/k"} <= set(nt["predicted_width_ratio"])
-        assert (out / "figures" / f"next_test_{asm}.png").is_file() and (out / "design" / asm / "next_test.csv").is_file()
+        assert (out / "figures" / f"next_test_{asm}_{unit(out, asm)}.png").is_file() and (out / "design" / asm / unit(out, asm) / "next_test.csv").is_file()
     # the summary opens on the verdict, in its order, before Table 3.2 and the details
     page = (out / "report" / "summary.html").read_text()
     order = [page.index(s) for s in ("reproduce the measured envelopes", "fixture_flexibility",

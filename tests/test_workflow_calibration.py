@@ -14,7 +14,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 import yaml
-from _campaign import REPO
+from _campaign import REPO, unit
 from _modal_tables import TABLE_3_2, write_tables
 
 pytestmark = pytest.mark.slow
@@ -68,16 +68,16 @@ def test_calibrate_then_posterior_then_nothing_to_do_until_the_config_changes(wo
     assert res.returncode == 0, res.stderr
     out = workdir / "results"
     for a in TABLE_3_2:
-        assert (out / "calibration" / a / "ga_best.json").is_file()
-        assert (out / "figures" / f"ga_exploration_{a}.png").stat().st_size > 10_000
-        assert "calibrated" in (out / "logs" / "calibrate" / f"{a}.log").read_text()
+        assert (out / "calibration" / a / unit(out, a) / "ga_best.json").is_file()
+        assert (out / "figures" / f"ga_exploration_{a}_{unit(out, a)}.png").stat().st_size > 10_000
+        assert "calibrated" in (out / "logs" / "calibrate" / a / f"{unit(out, a)}.log").read_text()
     assert not (out / "posterior").exists()  # `calibrate` runs only what it needs
     res = _snakemake(workdir, "posterior", "summary")
     assert res.returncode == 0, res.stderr
     assert "calibrate_assembly" not in res.stderr  # the GA is not rerun
     for a in TABLE_3_2:
-        assert "NOT converged" in (out / "posterior" / a / "constraints.txt").read_text()  # 600 steps only
-        assert (out / "figures" / f"corner_{a}.png").is_file()
+        assert "NOT converged" in (out / "posterior" / a / unit(out, a) / "constraints.txt").read_text()  # 600 steps only
+        assert (out / "figures" / f"corner_{a}_{unit(out, a)}.png").is_file()
     table = pd.read_csv(out / "posterior" / "table_3_2.csv")
     assert len(table) == 12 and set(table["assembly"]) == set(TABLE_3_2)
     md = (out / "posterior" / "table_3_2.md").read_text()
@@ -103,7 +103,7 @@ def test_calibrate_then_posterior_then_nothing_to_do_until_the_config_changes(wo
     # without the validation, discrepancy and design stages the verdict says they did not run, in its order
     assert summary.index("The validation stage did not run") < summary.index("What do the data identify")
     assert "The design stage did not run" in summary
-    assert "This run: NOT converged" in (out / "report" / "corner_first.rst").read_text()
+    assert "This run: NOT converged" in (out / "report" / f"corner_first_{unit(out, 'first')}.rst").read_text()
 
 
 def test_bad_input_is_one_sentence_naming_the_file(workdir):
@@ -111,11 +111,12 @@ def test_bad_input_is_one_sentence_naming_the_file(workdir):
     df = pd.read_csv(modal, dtype={"flags": str})
     df.loc[df["assembly"] == "first", "flags"] = "unusable"
     df.to_csv(modal, index=False)
-    res = _snakemake(workdir, "results/calibration/first/ga_best.json")  # that GA alone: not the other's too
+    mode = unit(workdir / "results", "first")
+    res = _snakemake(workdir, f"results/calibration/first/{mode}/ga_best.json")  # that GA alone: not the other's too
     assert res.returncode != 0
-    assert ("results/modal/modal_properties.csv: all 12 runs of assembly 'first' are flagged unusable"
+    assert (f"results/modal/first/{mode}/modal_properties.csv: all 12 runs of assembly 'first' are flagged unusable"
             in res.stderr), res.stderr
-    assert "Traceback" not in (workdir / "results" / "logs" / "calibrate" / "first.log").read_text()
+    assert "Traceback" not in (workdir / "results" / "logs" / "calibrate" / "first" / f"{mode}.log").read_text()
 
 
 def test_lint_reports_only_the_expected_conda_advice(workdir):

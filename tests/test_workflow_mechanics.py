@@ -18,7 +18,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 from _campaign import REPO, SMALL_CAMPAIGN, edit_manifest
-from _modal_tables import TABLE_3_2, write_tables
+from _modal_tables import TABLE_3_2, modal_tables, write_tables
 
 from jointcal._workflow import campaign_index, config_problem, pending_outputs, stage_sources
 from jointcal.calibrate import CalibrateSettings, run_calibration
@@ -26,7 +26,9 @@ from jointcal.posterior import PosteriorSettings, run_posterior
 
 SCRIPTS = REPO / "workflow" / "scripts"
 SCHEMA = REPO / "workflow" / "schemas" / "config.schema.yaml"
-DOWNSTREAM_OF_MODAL = {"modal_properties", "modal_figures", "calibrate_assembly", "calibration_figures",
+PER_UNIT = {"modal_unit", "calibrate_assembly", "calibration_figures", "posterior_assembly", "posterior_corner",
+            "validate_assembly", "discrepancy_assembly", "design_assembly"}
+DOWNSTREAM_OF_MODAL = {"modal_properties", "modal_figures", "modal_unit", "calibrate_assembly", "calibration_figures",
                        "posterior_assembly", "posterior_corner", "posterior_report", "report_summary",
                        "validate_assembly", "validate_figures", "discrepancy_assembly", "discrepancy_table",
                        "design_assembly"}
@@ -165,17 +167,22 @@ def touched(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[str]]:
         shutil.copytree(REPO / folder, work / folder, ignore=ignore, symlinks=True)
     shutil.copytree(REPO / "src" / "jointcal", work / "src" / "jointcal", ignore=ignore)
     cfg = ["--config", f"raw_data={SMALL_CAMPAIGN}", f"results={work / 'results'}"]
-    summary = _snakemake(work, "--summary", *cfg)
-    assert summary.returncode == 0, summary.stderr
-    for line in summary.stdout.splitlines()[1:]:
-        out = Path(line.split("\t")[0])
-        if not out.suffix:  # a directory() output (modal/frf, validation/<assembly>/envelopes)
-            out.mkdir(parents=True, exist_ok=True)
-            continue
-        out.parent.mkdir(parents=True, exist_ok=True)
-        out.touch()
-    res = _snakemake(work, "--cores", "1", "--touch", "--forceall", *cfg)
-    assert res.returncode == 0, res.stderr
+    modal = work / "results" / "modal" / "modal_properties.csv"
+    for _ in range(2):  # up to the modal checkpoint, then (once it is made) the (assembly, mode) jobs its table names
+        summary = _snakemake(work, "--summary", *cfg)
+        assert summary.returncode == 0, summary.stderr
+        for line in summary.stdout.splitlines()[1:]:
+            out = Path(line.split("\t")[0])
+            if not out.suffix:  # a directory() output (modal/frf, validation/<assembly>/envelopes)
+                out.mkdir(parents=True, exist_ok=True)
+                continue
+            out.parent.mkdir(parents=True, exist_ok=True)
+            out.touch()
+        if not modal.stat().st_size:  # the checkpoint's table, made by an ideal modal stage
+            table = modal_tables({"first": TABLE_3_2["first"]}, levels=(1, 1, 2, 5, 10))[0]
+            table.assign(run_id=[f"run{i:02d}" for i in range(1, 6)], mode="m2188").to_csv(modal, index=False)
+        res = _snakemake(work, "--cores", "1", "--touch", "--forceall", *cfg)
+        assert res.returncode == 0, res.stderr
     return work, cfg
 
 
@@ -191,7 +198,8 @@ def test_editing_a_stage_module_reruns_that_stage_and_its_descendants_only(touch
     work, cfg = touched
     pkg = work / "src" / "jointcal"
     cases = [
-        ("measure/modal.py", DOWNSTREAM_OF_MODAL),  # not ingest, not envelopes
+        # not ingest, not envelopes; the jobs of each (assembly, mode) are named once the modal checkpoint has run
+        ("measure/modal.py", DOWNSTREAM_OF_MODAL - PER_UNIT),
         ("report/calibration.py", {"calibration_figures", "posterior_corner", "posterior_report", "report_summary",
                                     "validate_figures", "design_assembly"}),  # figures and report pages only
         ("design/narrowing.py", {"design_assembly", "report_summary"}),  # the design and the verdict that reads it
@@ -219,8 +227,8 @@ def test_discrepancy_target_runs_only_that_stage_and_what_it_needs(touched, tmp_
         module.write_text(original)
     fresh = ["--config", f"raw_data={SMALL_CAMPAIGN}", f"results={tmp_path / 'fresh'}"]
     jobs = set(_jobs(_snakemake(work, "-n", "discrepancy", *fresh)))
-    assert {"ingest", "envelopes_runs", "calibrate_assembly", "validate_assembly", "discrepancy_assembly",
-            "discrepancy_table"} <= jobs
+    # (the jobs of each (assembly, mode), calibrate to discrepancy, are named once the modal checkpoint has run)
+    assert {"ingest", "envelopes_runs", "modal_properties", "discrepancy_table"} <= jobs
     assert not jobs & {"modal_figures", "calibration_figures", "posterior_corner", "validate_figures",
                        "report_summary"}, jobs
 
@@ -241,26 +249,35 @@ def test_typo_in_config_is_one_line_before_any_schema_dump(touched):
 
 
 @pytest.mark.slow
-def test_slurm_profile_dry_run_has_one_job_per_assembly(tmp_path):
-    """On the example campaign (24 runs, 2 assemblies), with the profile's per-rule resources."""
+def test_slurm_profile_dry_run_has_one_job_per_assembly_and_mode(tmp_path, touched):
+    """On the example campaign (24 runs, 2 assemblies) up to the modal checkpoint, whose table names the
+    (assembly, mode) jobs after it; their resources on the touched small campaign, with the profile's values."""
     work = tmp_path / "wf"
     work.mkdir()
     shutil.copy(REPO / "Snakefile", work)
     shutil.copytree(REPO / "workflow", work / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
     shutil.copytree(REPO / "src" / "jointcal", work / "src" / "jointcal", ignore=shutil.ignore_patterns("__pycache__"))
-    res = _snakemake(work, "-n", "--workflow-profile", "workflow/profiles/slurm",
-                     "--config", f"raw_data={REPO / 'raw_data'}", f"results={tmp_path / 'results'}")
+    slurm = ["--workflow-profile", "workflow/profiles/slurm"]
+    res = _snakemake(work, "-n", *slurm, "--config", f"raw_data={REPO / 'raw_data'}", f"results={tmp_path / 'results'}")
     assert "workflow/profiles/slurm" in res.stderr + res.stdout
+    assert "checkpoint" in res.stderr + res.stdout  # the jobs after modal are named by its table
     assert _jobs(res) == {"compile_kernels": 1, "ingest": 1, "envelopes_runs": 1, "modal_properties": 1, "modal_figures": 1,
-                          "calibrate_assembly": 2, "calibration_figures": 2, "posterior_assembly": 2,
-                          "posterior_corner": 2, "posterior_report": 1, "report_summary": 1,
-                          "validate_assembly": 2, "validate_figures": 1, "discrepancy_assembly": 2,
-                          "discrepancy_table": 1, "design_assembly": 2, "all": 1}
+                          "posterior_report": 1, "report_summary": 1, "validate_figures": 1, "discrepancy_table": 1,
+                          "all": 1}
+    blocks = re.findall(r"rule (\w+):\n(?:    .*\n)*?    resources: (.*)", res.stdout + res.stderr)
+    resources = {rule: dict(kv.split("=", 1) for kv in line.split(", ")) for rule, line in blocks}
+    assert resources["envelopes_runs"]["runtime"] == "15" and resources["ingest"]["cpus_per_task"] == "1"
+    assert resources["envelopes_runs"]["cpus_per_task"] == "2"
+    twork, cfg = touched
+    per_unit = ["calibrate_assembly", "posterior_assembly", "validate_assembly", "discrepancy_assembly", "design_assembly"]
+    res = _snakemake(twork, "-n", *slurm, *cfg, "--forcerun", *per_unit)
+    jobs = _jobs(res)
+    assert all(jobs[r] == 1 for r in per_unit), jobs  # the small campaign: one assembly, one mode
+    assert re.search(r"wildcards: assembly=first, mode=m2188", res.stdout + res.stderr)
     blocks = re.findall(r"rule (\w+):\n(?:    .*\n)*?    resources: (.*)", res.stdout + res.stderr)
     resources = {rule: dict(kv.split("=", 1) for kv in line.split(", ")) for rule, line in blocks}
     assert resources["calibrate_assembly"]["runtime"] == "30" and resources["posterior_assembly"]["runtime"] == "60"
-    assert resources["envelopes_runs"]["runtime"] == "15" and resources["ingest"]["cpus_per_task"] == "1"
-    assert resources["envelopes_runs"]["cpus_per_task"] == "2" == resources["validate_assembly"]["cpus_per_task"]
+    assert resources["validate_assembly"]["cpus_per_task"] == "2"
 
 
 @pytest.mark.slow
@@ -268,7 +285,8 @@ def test_failed_rerun_removes_the_downstream_outputs_it_could_not_remake(touched
     work, cfg = touched
     results = work / "results"
     upstream = sorted(p for p in (results / "envelopes").iterdir()) + [results / "ingest" / "runs.csv"]
-    downstream = [results / "calibration" / "first" / "ga_best.json", results / "posterior" / "first" / "summary.csv",
+    downstream = [results / "calibration" / "first" / "m2188" / "ga_best.json",
+                  results / "posterior" / "first" / "m2188" / "summary.csv",
                   results / "posterior" / "table_3_2.csv", results / "figures" / "fig3_8_amplitude_fit.png",
                   results / "figures" / "fig3_5_envelopes.png"]
     assert all(p.is_file() for p in upstream + downstream)

@@ -2,7 +2,9 @@
 
 `campaign_index` reads the campaign's manifest once, with `jointcal.io.read_manifest`, for
 the names the workflow's DAG is built from (run ids, record files, assemblies, excitation).
-`pending_outputs` reads Snakemake's ``--summary`` table for the files still planned to be remade.
+`modal_units` reads the modal stage's table for the (assembly, mode) pairs the later stages run on
+(`unit_of` reads the pair back from a per-unit output's path). `pending_outputs` reads Snakemake's
+``--summary`` table for the files still planned to be remade.
 """
 from __future__ import annotations
 
@@ -11,7 +13,7 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["CampaignIndex", "campaign_index", "pending_outputs"]
+__all__ = ["CampaignIndex", "campaign_index", "modal_units", "unit_table", "unit_outputs", "unit_of", "unit_labels", "pending_outputs"]
 
 
 @dataclass(frozen=True)
@@ -89,6 +91,111 @@ def campaign_index(manifest: str | os.PathLike[str]) -> CampaignIndex:
                          run_assembly=dict(zip(ids, (str(a) for a in table["assembly"]))),
                          excitation=excitation_kind(table.columns),
                          problem=problem)
+
+
+def _with_modes(t):
+    """A modal table with its ``mode`` column; a table without one (made before modes were tracked, or by
+    hand) holds one mode per assembly, named by its frequency at the assembly's lowest level."""
+    import numpy as np
+
+    from jointcal.io import level_column
+    from jointcal.measure.modes import mode_name
+
+    if "mode" in t.columns:
+        return t.assign(mode=t["mode"].fillna("").astype(str))
+    level = level_column(t.columns)
+    names = {}
+    for asm, g in t.groupby("assembly", sort=False):
+        ok = g[np.isfinite(g["f_res_hz"].astype(float))] if "f_res_hz" in g else g.iloc[:0]
+        low = ok.sort_values(level, kind="stable") if level and len(ok) else ok
+        names[asm] = mode_name(float(low["f_res_hz"].iloc[0])) if len(low) else "m0"
+    return t.assign(mode=t["assembly"].map(names))
+
+
+def unit_table(modal, assembly: str, mode: str):
+    """The rows of one (assembly, mode) of a modal table (a DataFrame read with text ``assembly``)."""
+    t = _with_modes(modal)
+    return t[(t["assembly"].astype(str) == assembly) & (t["mode"] == mode)]
+
+
+def modal_units(modal_csv: str | os.PathLike[str]) -> list[tuple[str, str]]:
+    """The (assembly, mode) pairs calibrated: each mode read in usable runs at two levels or more.
+
+    An assembly none of whose modes has two levels keeps its mode read in the most usable runs (or,
+    with none usable, its first), so that its calibration stops with the sentence that names the cause.
+
+    Parameters
+    ----------
+    modal_csv : path-like
+        The modal stage's ``modal_properties.csv`` (columns ``assembly``, ``mode``, ``flags``, ``f_res_hz``
+        and a level column, `jointcal.io.level_column`; without ``mode``, one mode per assembly).
+
+    Returns
+    -------
+    list of (str, str)
+        In the order of the assemblies' first rows, modes by ascending frequency.
+    """
+    import numpy as np
+    import pandas as pd
+
+    from jointcal.io import level_column
+
+    t = _with_modes(pd.read_csv(modal_csv, dtype={"assembly": str, "mode": str, "flags": str}))
+    t = t[t["mode"] != ""]
+    level = level_column(t.columns)
+    f = pd.to_numeric(t.get("f_res_hz", pd.Series(np.nan, index=t.index)), errors="coerce")
+    usable = t[~t["flags"].fillna("").str.contains("unusable") & np.isfinite(f)]
+    out = []
+    for asm, g in t.groupby("assembly", sort=False):
+        u = usable[usable["assembly"] == asm]
+        order = f[g.index].groupby(g["mode"], sort=False).median().sort_values(na_position="last").index
+        n_levels = u.groupby("mode")[level].nunique() if level and len(u) else pd.Series(dtype=int)
+        kept = [m for m in order if n_levels.get(m, 0) >= 2]
+        if not kept:
+            counts = u["mode"].value_counts()
+            kept = [counts.index[0] if len(counts) else order[0]]
+        out += [(str(asm), str(m)) for m in kept]
+    return out
+
+
+def unit_of(path: str | os.PathLike[str]) -> tuple[str, str]:
+    """(assembly, mode) of a per-unit output ``<stage>/<assembly>/<mode>/<file>``."""
+    p = Path(path)
+    return p.parent.parent.name, p.parent.name
+
+
+def unit_labels(paths) -> list[str]:
+    """How the report names the unit of each per-unit output: its assembly, followed by the mode
+    (``bert_5Nm m95``) wherever one assembly has more than one unit calibrated."""
+    units = [unit_of(p) for p in paths]
+    per_assembly = {}
+    for a, m in units:
+        per_assembly.setdefault(a, set()).add(m)
+    return [a if len(per_assembly[a]) == 1 else f"{a} {m}" for a, m in units]
+
+
+def unit_outputs(results: str | os.PathLike[str], *, before: float,
+                 stages=("modal", "calibration", "posterior", "validation", "discrepancy", "design"),
+                 mode_re: str = r"m\d+(?:_\d+p\d)?") -> list[Path]:
+    """The files of every (assembly, mode) unit under `results`, last written before `before`.
+
+    A unit's outputs are the files under ``<stage>/<assembly>/<mode>/`` and the figures and captions
+    named ``*_<assembly>_<mode>.png`` / ``.rst``. When the modal checkpoint is to be remade, Snakemake's
+    summary cannot name the jobs after it (its table names them), so after a failed run these are the
+    outputs that may be out of date.
+    """
+    import re
+
+    results = Path(results)
+    units = {(d.parent.name, d.name) for d in (results / "modal").glob("*/*")
+             if d.is_dir() and re.fullmatch(mode_re, d.name)}
+    out = []
+    for a, m in sorted(units):
+        for stage in stages:
+            out += [f for f in (results / stage / a / m).rglob("*") if f.is_file()]
+        for folder in ("figures", "report"):
+            out += [f for f in (results / folder).glob(f"*_{a}_{m}.*") if f.is_file()]
+    return [f for f in out if f.stat().st_mtime < before]
 
 
 def pending_outputs(summary: str, *, before: float) -> list[Path]:

@@ -30,9 +30,11 @@ from typing import Any
 
 import yaml
 
-from ._campaign_index import CampaignIndex, campaign_index, pending_outputs  # noqa: F401 (re-exported)
+from ._campaign_index import (CampaignIndex, campaign_index, modal_units, pending_outputs,  # noqa: F401 (re-exported)
+                              unit_labels, unit_of, unit_outputs, unit_table)
 
-__all__ = ["stage_sources", "stage_hash", "CampaignIndex", "campaign_index", "pending_outputs", "config_problem"]
+__all__ = ["stage_sources", "stage_hash", "CampaignIndex", "campaign_index", "modal_units", "unit_of", "unit_labels", "unit_table", "unit_outputs", "pending_outputs",
+           "config_problem"]
 
 _PACKAGE = "jointcal"
 _ROOT = Path(__file__).resolve().parent  # the jointcal package being imported

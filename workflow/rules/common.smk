@@ -9,7 +9,7 @@ from pathlib import Path
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
-from jointcal._workflow import campaign_index, config_problem, pending_outputs, stage_hash
+from jointcal._workflow import campaign_index, config_problem, modal_units, pending_outputs, stage_hash, unit_outputs
 from jointcal.io import write_bytes_atomic
 
 # Config: an unknown key (a typo) is one line naming the nearest valid key, before the schema's own
@@ -49,6 +49,7 @@ RUN_IDS = list(RUN_FILES)
 ASSEMBLIES = CAMPAIGN.assemblies
 ASSEMBLY_RE = "|".join(re.escape(a) for a in ASSEMBLIES) or "no-assembly"
 EXCITATION = CAMPAIGN.excitation  # base, force or voltage, from the manifest's level column
+MODE_RE = r"m\d+(?:_\d+p\d)?"  # a mode's name (jointcal.measure.modes.mode_name): m18, m95
 
 # Each stage's folder under RESULTS (stages in the order data flows).
 INGEST = RESULTS / "ingest"
@@ -73,6 +74,23 @@ def pool_threads(wildcards):
     except (WorkflowError, TypeError, ValueError):  # no --cores (a dry run or --lint)
         return 1
     return max(1, min(cores, 64) // max(1, len(ASSEMBLIES)))
+
+
+def units():
+    """The (assembly, mode) pairs the stages after modal run on, from the modal checkpoint's table
+    (jointcal._workflow.modal_units: each mode read at two levels or more)."""
+    if has_rule("modal_properties"):
+        return modal_units(checkpoints.modal_properties.get().output.table)
+    return modal_units(MODAL / "modal_properties.csv")  # a workflow of the later stages, on their tables
+
+
+def unit_files(*patterns):
+    """An input function: each pattern (with {assembly} and {mode}) for every unit of the campaign."""
+
+    def files(wildcards):
+        return [str(p).format(assembly=a, mode=m) for p in patterns for a, m in units()]
+
+    return files
 
 
 def checked_campaign():
@@ -123,11 +141,11 @@ def verdict_inputs(wildcards):
     """The later stages' outputs the verdict reads, for the stages this workflow has."""
     out = {}
     if has_rule("validate_assembly"):
-        out["validation"] = [str(VALIDATION / a / "summary.json") for a in ASSEMBLIES]
+        out["validation"] = [str(VALIDATION / a / m / "summary.json") for a, m in units()]
     if has_rule("discrepancy_assembly") and EXCITATION == "base":
-        out["diagnosis"] = [str(DISCREPANCY / a / "diagnosis.json") for a in ASSEMBLIES]
+        out["diagnosis"] = [str(DISCREPANCY / a / m / "diagnosis.json") for a, m in units()]
     if has_rule("design_assembly"):
-        out["design"] = [str(DESIGN / a / "next_test.json") for a in ASSEMBLIES]
+        out["design"] = [str(DESIGN / a / m / "next_test.json") for a, m in units()]
     return out
 
 
@@ -160,6 +178,9 @@ def remove_stale_outputs():
     summary = subprocess.run([sys.executable, "-m", "snakemake", *sys.argv[1:], "--summary", "--nolock"],
                              capture_output=True, text=True)
     stale = pending_outputs(summary.stdout, before=STARTED)
+    table = MODAL / "modal_properties.csv"
+    if not table.is_file() or table.resolve() in {f.resolve() for f in stale}:  # the summary cannot list the jobs its table names
+        stale += [f for f in unit_outputs(RESULTS, before=STARTED) if f not in stale]
     for f in stale:
         f.unlink(missing_ok=True)
     if stale:

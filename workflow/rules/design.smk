@@ -6,19 +6,19 @@
 rule design_assembly:
     input:
         runs=INGEST / "runs.csv",
-        modal=MODAL / "modal_properties.csv",
-        scatter=MODAL / "scatter.csv",
-        best=CALIBRATION / "{assembly}" / "ga_best.json",
-        chain=POSTERIOR / "{assembly}" / "chain.npz",
-        identified=POSTERIOR / "{assembly}" / "identified.csv",
+        modal=MODAL / "{assembly}" / "{mode}" / "modal_properties.csv",
+        scatter=MODAL / "{assembly}" / "{mode}" / "scatter.csv",
+        best=CALIBRATION / "{assembly}" / "{mode}" / "ga_best.json",
+        chain=POSTERIOR / "{assembly}" / "{mode}" / "chain.npz",
+        identified=POSTERIOR / "{assembly}" / "{mode}" / "identified.csv",
         kernels=ancient(KERNELS),
     output:
-        json=DESIGN / "{assembly}" / "next_test.json",
-        csv=DESIGN / "{assembly}" / "next_test.csv",
-        markdown=report(DESIGN / "{assembly}" / "next_test.md", caption="../report/next_test_md.rst",
-                        category="6. Next test", subcategory="{assembly}"),
-        figure=report(FIGURES / "next_test_{assembly}.png", caption="../report/next_test.rst",
-                      category="6. Next test", subcategory="{assembly}"),
+        json=DESIGN / "{assembly}" / "{mode}" / "next_test.json",
+        csv=DESIGN / "{assembly}" / "{mode}" / "next_test.csv",
+        markdown=report(DESIGN / "{assembly}" / "{mode}" / "next_test.md", caption="../report/next_test_md.rst",
+                        category="6. Next test", subcategory="{assembly} {mode}"),
+        figure=report(FIGURES / "next_test_{assembly}_{mode}.png", caption="../report/next_test.rst",
+                      category="6. Next test", subcategory="{assembly} {mode}"),
     params:
         code=source_hash("design.py"),
         design=config.get("design", {}),
@@ -27,16 +27,17 @@ rule design_assembly:
         modal=config["modal"],
     wildcard_constraints:
         assembly=ASSEMBLY_RE,
+        mode=MODE_RE,
     threads: 1
     benchmark:
-        RESULTS / "benchmarks" / "design_assembly" / "{assembly}.tsv"
+        RESULTS / "benchmarks" / "design_assembly" / "{assembly}" / "{mode}.tsv"
     log:
-        RESULTS / "logs" / "design" / "{assembly}.log",
+        RESULTS / "logs" / "design" / "{assembly}" / "{mode}.log",
     script:
         "../scripts/design.py"
 
 
 rule design:
     input:
-        expand(DESIGN / "{assembly}" / "next_test.json", assembly=ASSEMBLIES),
-        expand(FIGURES / "next_test_{assembly}.png", assembly=ASSEMBLIES),
+        unit_files(DESIGN / "{assembly}" / "{mode}" / "next_test.json"),
+        unit_files(FIGURES / "next_test_{assembly}_{mode}.png"),

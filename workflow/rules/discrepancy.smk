@@ -7,25 +7,25 @@
 rule discrepancy_assembly:
     input:
         runs=INGEST / "runs.csv",
-        modal=MODAL / "modal_properties.csv",
+        modal=MODAL / "{assembly}" / "{mode}" / "modal_properties.csv",
         env=expand(ENVELOPES / "{run_id}.csv", run_id=RUN_IDS),
-        best=CALIBRATION / "{assembly}" / "ga_best.json",
-        history=CALIBRATION / "{assembly}" / "ga_history.csv",
-        validation=VALIDATION / "{assembly}" / "summary.json",
+        best=CALIBRATION / "{assembly}" / "{mode}" / "ga_best.json",
+        history=CALIBRATION / "{assembly}" / "{mode}" / "ga_history.csv",
+        validation=VALIDATION / "{assembly}" / "{mode}" / "summary.json",
         records=assembly_records,
         kernels=ancient(KERNELS),
     output:
-        diagnosis=DISCREPANCY / "{assembly}" / "diagnosis.json",
-        markdown=report(DISCREPANCY / "{assembly}" / "diagnosis.md", caption="../report/discrepancy_md.rst",
-                        category="5. Discrepancy", subcategory="{assembly}"),
-        residuals=DISCREPANCY / "{assembly}" / "residuals.csv",
-        metrics_after=DISCREPANCY / "{assembly}" / "metrics_after.csv",
-        residual_figure=report(FIGURES / "discrepancy_residuals_{assembly}.png",
+        diagnosis=DISCREPANCY / "{assembly}" / "{mode}" / "diagnosis.json",
+        markdown=report(DISCREPANCY / "{assembly}" / "{mode}" / "diagnosis.md", caption="../report/discrepancy_md.rst",
+                        category="5. Discrepancy", subcategory="{assembly} {mode}"),
+        residuals=DISCREPANCY / "{assembly}" / "{mode}" / "residuals.csv",
+        metrics_after=DISCREPANCY / "{assembly}" / "{mode}" / "metrics_after.csv",
+        residual_figure=report(FIGURES / "discrepancy_residuals_{assembly}_{mode}.png",
                                caption="../report/discrepancy_residuals.rst", category="5. Discrepancy",
-                               subcategory="{assembly}"),
-        before_after_figure=report(FIGURES / "discrepancy_before_after_{assembly}.png",
+                               subcategory="{assembly} {mode}"),
+        before_after_figure=report(FIGURES / "discrepancy_before_after_{assembly}_{mode}.png",
                                    caption="../report/discrepancy_before_after.rst", category="5. Discrepancy",
-                                   subcategory="{assembly}"),
+                                   subcategory="{assembly} {mode}"),
     params:
         code=source_hash("discrepancy.py"),
         discrepancy=config.get("discrepancy", {}),
@@ -35,26 +35,26 @@ rule discrepancy_assembly:
         modal=config["modal"],
     wildcard_constraints:
         assembly=ASSEMBLY_RE,
+        mode=MODE_RE,
     threads: pool_threads
     priority: 10  # on the longest chain of jobs (figures and tables fill the gaps)
     benchmark:
-        RESULTS / "benchmarks" / "discrepancy_assembly" / "{assembly}.tsv"
+        RESULTS / "benchmarks" / "discrepancy_assembly" / "{assembly}" / "{mode}.tsv"
     log:
-        RESULTS / "logs" / "discrepancy" / "{assembly}.log",
+        RESULTS / "logs" / "discrepancy" / "{assembly}" / "{mode}.log",
     script:
         "../scripts/discrepancy.py"
 
 
 rule discrepancy_table:
     input:
-        best=expand(CALIBRATION / "{assembly}" / "ga_best.json", assembly=ASSEMBLIES),
-        diagnosis=expand(DISCREPANCY / "{assembly}" / "diagnosis.json", assembly=ASSEMBLIES),
+        best=unit_files(CALIBRATION / "{assembly}" / "{mode}" / "ga_best.json"),
+        diagnosis=unit_files(DISCREPANCY / "{assembly}" / "{mode}" / "diagnosis.json"),
     output:
         table=report(DISCREPANCY / "table_3_2_corrected.html", caption="../report/table_3_2_corrected.rst",
                      category="5. Discrepancy"),
     params:
         code=source_hash("discrepancy_table.py"),
-        assemblies=ASSEMBLIES,
     threads: 1
     benchmark:
         RESULTS / "benchmarks" / "discrepancy_table.tsv"
@@ -66,5 +66,5 @@ rule discrepancy_table:
 
 rule discrepancy:
     input:
-        expand(DISCREPANCY / "{assembly}" / "diagnosis.json", assembly=ASSEMBLIES) if EXCITATION == "base" else [],
+        unit_files(DISCREPANCY / "{assembly}" / "{mode}" / "diagnosis.json") if EXCITATION == "base" else [],
         rules.discrepancy_table.output if EXCITATION == "base" else [],

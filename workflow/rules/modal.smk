@@ -1,6 +1,6 @@
 # Stage modal: resonance, damping and amplitude per run, scatter across repeats (jointcal.measure.modal).
 
-rule modal_properties:
+checkpoint modal_properties:  # its table names the (assembly, mode) units of the later stages
     input:
         runs=INGEST / "runs.csv",
         env=expand(ENVELOPES / "{run_id}.csv", run_id=RUN_IDS),

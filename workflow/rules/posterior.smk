@@ -4,65 +4,67 @@
 
 rule posterior_assembly:
     input:
-        modal=MODAL / "modal_properties.csv",
-        scatter=MODAL / "scatter.csv",
-        best=CALIBRATION / "{assembly}" / "ga_best.json",
+        modal=MODAL / "{assembly}" / "{mode}" / "modal_properties.csv",
+        scatter=MODAL / "{assembly}" / "{mode}" / "scatter.csv",
+        best=CALIBRATION / "{assembly}" / "{mode}" / "ga_best.json",
     output:
-        summary=POSTERIOR / "{assembly}" / "summary.csv",
-        chain=POSTERIOR / "{assembly}" / "chain.npz",
-        constraints=POSTERIOR / "{assembly}" / "constraints.txt",
-        predictive=POSTERIOR / "{assembly}" / "predictive.csv",
-        identified=POSTERIOR / "{assembly}" / "identified.csv",
+        summary=POSTERIOR / "{assembly}" / "{mode}" / "summary.csv",
+        chain=POSTERIOR / "{assembly}" / "{mode}" / "chain.npz",
+        constraints=POSTERIOR / "{assembly}" / "{mode}" / "constraints.txt",
+        predictive=POSTERIOR / "{assembly}" / "{mode}" / "predictive.csv",
+        identified=POSTERIOR / "{assembly}" / "{mode}" / "identified.csv",
     params:
         code=source_hash("posterior.py"),
         calibrate=config.get("calibrate", {}),
         posterior=config.get("posterior", {}),
-        checkpoint=lambda wc: str(RESULTS / "checkpoints" / "posterior" / f"{wc.assembly}.npz"),
+        checkpoint=lambda wc: str(RESULTS / "checkpoints" / "posterior" / f"{wc.assembly}_{wc.mode}.npz"),
     wildcard_constraints:
         assembly=ASSEMBLY_RE,
+        mode=MODE_RE,
     threads: 1
     priority: 10  # on the longest chain of jobs (figures and tables fill the gaps)
     benchmark:
-        RESULTS / "benchmarks" / "posterior_assembly" / "{assembly}.tsv"
+        RESULTS / "benchmarks" / "posterior_assembly" / "{assembly}" / "{mode}.tsv"
     log:
-        RESULTS / "logs" / "posterior" / "{assembly}.log",
+        RESULTS / "logs" / "posterior" / "{assembly}" / "{mode}.log",
     script:
         "../scripts/posterior.py"
 
 
 rule posterior_corner:
     input:
-        chain=POSTERIOR / "{assembly}" / "chain.npz",
-        constraints=POSTERIOR / "{assembly}" / "constraints.txt",
-        best=CALIBRATION / "{assembly}" / "ga_best.json",
-        history=CALIBRATION / "{assembly}" / "ga_history.csv",
+        chain=POSTERIOR / "{assembly}" / "{mode}" / "chain.npz",
+        constraints=POSTERIOR / "{assembly}" / "{mode}" / "constraints.txt",
+        best=CALIBRATION / "{assembly}" / "{mode}" / "ga_best.json",
+        history=CALIBRATION / "{assembly}" / "{mode}" / "ga_history.csv",
     output:
-        corner=report(FIGURES / "corner_{assembly}.png", caption="../report/corner.rst",
-                      category="3. Posterior", subcategory="{assembly}"),
-        caption=REPORT / "corner_{assembly}.rst",
+        corner=report(FIGURES / "corner_{assembly}_{mode}.png", caption="../report/corner.rst",
+                      category="3. Posterior", subcategory="{assembly} {mode}"),
+        caption=REPORT / "corner_{assembly}_{mode}.rst",
     params:
         code=source_hash("posterior_corner.py"),
         calibrate=config.get("calibrate", {}),
         posterior=config.get("posterior", {}),
     wildcard_constraints:
         assembly=ASSEMBLY_RE,
+        mode=MODE_RE,
     threads: 1
     benchmark:
-        RESULTS / "benchmarks" / "posterior_corner" / "{assembly}.tsv"
+        RESULTS / "benchmarks" / "posterior_corner" / "{assembly}" / "{mode}.tsv"
     log:
-        RESULTS / "logs" / "posterior_corner" / "{assembly}.log",
+        RESULTS / "logs" / "posterior_corner" / "{assembly}" / "{mode}.log",
     script:
         "../scripts/posterior_corner.py"
 
 
 rule posterior_report:
     input:
-        modal=MODAL / "modal_properties.csv",
-        best=expand(CALIBRATION / "{assembly}" / "ga_best.json", assembly=ASSEMBLIES),
-        curves=expand(CALIBRATION / "{assembly}" / "model_curves.csv", assembly=ASSEMBLIES),
-        summary=expand(POSTERIOR / "{assembly}" / "summary.csv", assembly=ASSEMBLIES),
-        predictive=expand(POSTERIOR / "{assembly}" / "predictive.csv", assembly=ASSEMBLIES),
-        identified=expand(POSTERIOR / "{assembly}" / "identified.csv", assembly=ASSEMBLIES),
+        modal=unit_files(MODAL / "{assembly}" / "{mode}" / "modal_properties.csv"),
+        best=unit_files(CALIBRATION / "{assembly}" / "{mode}" / "ga_best.json"),
+        curves=unit_files(CALIBRATION / "{assembly}" / "{mode}" / "model_curves.csv"),
+        summary=unit_files(POSTERIOR / "{assembly}" / "{mode}" / "summary.csv"),
+        predictive=unit_files(POSTERIOR / "{assembly}" / "{mode}" / "predictive.csv"),
+        identified=unit_files(POSTERIOR / "{assembly}" / "{mode}" / "identified.csv"),
     output:
         figure=report(FIGURES / "fig3_8_amplitude_fit.png", caption="../report/fig3_8_amplitude_fit.rst",
                       category="3. Posterior"),
@@ -72,7 +74,6 @@ rule posterior_report:
     params:
         code=source_hash("posterior_report.py"),
         calibrate=config.get("calibrate", {}),
-        assemblies=ASSEMBLIES,
     threads: 1
     benchmark:
         RESULTS / "benchmarks" / "posterior_report.tsv"
@@ -84,6 +85,6 @@ rule posterior_report:
 
 rule posterior:
     input:
-        expand(POSTERIOR / "{assembly}" / "summary.csv", assembly=ASSEMBLIES),
-        expand(FIGURES / "corner_{assembly}.png", assembly=ASSEMBLIES),
+        unit_files(POSTERIOR / "{assembly}" / "{mode}" / "summary.csv"),
+        unit_files(FIGURES / "corner_{assembly}_{mode}.png"),
         rules.posterior_report.output,

@@ -10,13 +10,14 @@ rule report_summary:
         unpack(verdict_inputs),
         runs=ingest_table,
         modal=MODAL / "modal_properties.csv",
-        scatter=MODAL / "scatter.csv",
+        unit_modal=unit_files(MODAL / "{assembly}" / "{mode}" / "modal_properties.csv"),
+        unit_scatter=unit_files(MODAL / "{assembly}" / "{mode}" / "scatter.csv"),
         table=POSTERIOR / "table_3_2.csv",
-        history=expand(CALIBRATION / "{assembly}" / "ga_history.csv", assembly=ASSEMBLIES),
-        best=expand(CALIBRATION / "{assembly}" / "ga_best.json", assembly=ASSEMBLIES),
-        chain=expand(POSTERIOR / "{assembly}" / "chain.npz", assembly=ASSEMBLIES),
-        constraints=expand(POSTERIOR / "{assembly}" / "constraints.txt", assembly=ASSEMBLIES),
-        identified=expand(POSTERIOR / "{assembly}" / "identified.csv", assembly=ASSEMBLIES),
+        history=unit_files(CALIBRATION / "{assembly}" / "{mode}" / "ga_history.csv"),
+        best=unit_files(CALIBRATION / "{assembly}" / "{mode}" / "ga_best.json"),
+        chain=unit_files(POSTERIOR / "{assembly}" / "{mode}" / "chain.npz"),
+        constraints=unit_files(POSTERIOR / "{assembly}" / "{mode}" / "constraints.txt"),
+        identified=unit_files(POSTERIOR / "{assembly}" / "{mode}" / "identified.csv"),
     output:
         summary=report(REPORT / "summary.html", caption="../report/summary.rst",
                        category="0. Summary"),
@@ -26,7 +27,6 @@ rule report_summary:
         code=source_hash("report_summary.py"),
         calibrate=config.get("calibrate", {}),
         posterior=config.get("posterior", {}),
-        assemblies=ASSEMBLIES,
         campaign=str(RAW_DATA),
     threads: 1
     benchmark:

@@ -5,15 +5,15 @@
 rule validate_assembly:
     input:
         runs=INGEST / "runs.csv",
-        modal=MODAL / "modal_properties.csv",
-        best=CALIBRATION / "{assembly}" / "ga_best.json",
-        chain=POSTERIOR / "{assembly}" / "chain.npz",
+        modal=MODAL / "{assembly}" / "{mode}" / "modal_properties.csv",
+        best=CALIBRATION / "{assembly}" / "{mode}" / "ga_best.json",
+        chain=POSTERIOR / "{assembly}" / "{mode}" / "chain.npz",
         records=assembly_records,
         kernels=ancient(KERNELS),
     output:
-        metrics=VALIDATION / "{assembly}" / "metrics.csv",
-        summary=VALIDATION / "{assembly}" / "summary.json",
-        envelopes=directory(VALIDATION / "{assembly}" / "envelopes"),
+        metrics=VALIDATION / "{assembly}" / "{mode}" / "metrics.csv",
+        summary=VALIDATION / "{assembly}" / "{mode}" / "summary.json",
+        envelopes=directory(VALIDATION / "{assembly}" / "{mode}" / "envelopes"),
     params:
         code=source_hash("validate.py"),
         validate=config.get("validate", {}),
@@ -21,27 +21,27 @@ rule validate_assembly:
         modal=config["modal"],
     wildcard_constraints:
         assembly=ASSEMBLY_RE,
+        mode=MODE_RE,
     threads: pool_threads
     priority: 10  # on the longest chain of jobs (figures and tables fill the gaps)
     benchmark:
-        RESULTS / "benchmarks" / "validate_assembly" / "{assembly}.tsv"
+        RESULTS / "benchmarks" / "validate_assembly" / "{assembly}" / "{mode}.tsv"
     log:
-        RESULTS / "logs" / "validate" / "{assembly}.log",
+        RESULTS / "logs" / "validate" / "{assembly}" / "{mode}.log",
     script:
         "../scripts/validate.py"
 
 
 rule validate_figures:
     input:
-        metrics=expand(VALIDATION / "{assembly}" / "metrics.csv", assembly=ASSEMBLIES),
-        summary=expand(VALIDATION / "{assembly}" / "summary.json", assembly=ASSEMBLIES),
-        envelopes=expand(VALIDATION / "{assembly}" / "envelopes", assembly=ASSEMBLIES),
+        metrics=unit_files(VALIDATION / "{assembly}" / "{mode}" / "metrics.csv"),
+        summary=unit_files(VALIDATION / "{assembly}" / "{mode}" / "summary.json"),
+        envelopes=unit_files(VALIDATION / "{assembly}" / "{mode}" / "envelopes"),
     output:
         figure=report(FIGURES / "fig3_11_validation.png", caption="../report/fig3_11_validation.rst",
                       category="4. Validation"),
     params:
         code=source_hash("validate_figures.py"),
-        assemblies=ASSEMBLIES,
     threads: 1
     benchmark:
         RESULTS / "benchmarks" / "validate_figures.tsv"
@@ -53,5 +53,5 @@ rule validate_figures:
 
 rule validate:
     input:
-        expand(VALIDATION / "{assembly}" / "summary.json", assembly=ASSEMBLIES),
+        unit_files(VALIDATION / "{assembly}" / "{mode}" / "summary.json"),
         rules.validate_figures.output,

@@ -33,8 +33,8 @@ def main(smk) -> None:
     try:
         settings = DiscrepancySettings.from_config(smk.params.discrepancy)
         runs = pd.read_csv(smk.input.runs, dtype={"flags": str})
-        rows = runs[runs["assembly"] == asm].to_dict("records")
-        modal = pd.read_csv(smk.input.modal, dtype={"flags": str})
+        modal = pd.read_csv(smk.input.modal, dtype={"flags": str})  # this (assembly, mode)'s rows
+        rows = runs[runs["run_id"].isin(modal["run_id"])].to_dict("records")
         env_dir = Path(smk.input.env[0]).parent
         envs = {r["run_id"]: pd.read_csv(env_dir / f"{r['run_id']}.csv") for r in rows
                 if (env_dir / f"{r['run_id']}.csv").is_file()}

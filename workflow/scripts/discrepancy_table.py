@@ -5,12 +5,13 @@
 import json
 from pathlib import Path
 
+from jointcal._workflow import unit_labels
 from jointcal.io import write_bytes_atomic
 from jointcal.report.discrepancy import table_3_2_corrected_html
 
 
 def main(smk) -> None:
-    names = list(smk.params.assemblies)
+    names = unit_labels(smk.input.best)  # assembly (and mode: jointcal._workflow)
     best = {a: json.loads(Path(p).read_text()) for a, p in zip(names, smk.input.best)}
     diag = {a: json.loads(Path(p).read_text()) for a, p in zip(names, smk.input.diagnosis)}
     write_bytes_atomic(table_3_2_corrected_html(best, diag).encode(), smk.output.table)

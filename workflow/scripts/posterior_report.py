@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from jointcal._workflow import unit_labels, unit_of
 from jointcal.calibrate import CalibrateSettings, read_modal
 from jointcal.io import write_bytes_atomic, write_csv_atomic
 from jointcal.report.calibration import amplitude_figure
@@ -15,12 +16,12 @@ from jointcal.report.tables import qsma_vs_harmonic_balance, table_3_2, table_3_
 
 def main(smk) -> None:
     cal = CalibrateSettings.from_config(smk.params.calibrate)
-    names = list(smk.params.assemblies)
+    names = unit_labels(smk.input.best)  # assembly (and mode: jointcal._workflow)
     best = {a: json.loads(Path(p).read_text()) for a, p in zip(names, smk.input.best)}
     summaries = {a: pd.read_csv(p) for a, p in zip(names, smk.input.summary)}
     measured, comparison = {}, []
-    for a in names:
-        d = read_modal(smk.input.modal, a, damping=cal.damping)
+    for a, unit_modal in zip(names, smk.input.modal):
+        d = read_modal(unit_modal, unit_of(unit_modal)[0], damping=cal.damping)
         measured[a] = pd.DataFrame({"q_in": d.q, "f_hz": d.f, "zeta": d.zeta})
         by_level = pd.notna(d.level).all()
         q = pd.Series(d.q).groupby(d.level if by_level else list(d.run_id), sort=by_level).mean()  # one q per level

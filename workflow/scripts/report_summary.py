@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from jointcal._workflow import unit_labels, unit_of
 from jointcal.calibrate import PARAMS, CalibrateSettings, model_words, read_modal
 from jointcal.io import write_bytes_atomic
 from jointcal.posterior import NAMES, PosteriorSettings, find_modes
@@ -47,7 +48,7 @@ def _details(arrays: dict, modes: pd.DataFrame | None, identified: pd.DataFrame)
 def main(smk) -> None:
     cal = CalibrateSettings.from_config(smk.params.calibrate)
     post = PosteriorSettings.from_config(smk.params.posterior)
-    names = list(smk.params.assemblies)
+    names = unit_labels(smk.input.best)  # assembly (and mode: jointcal._workflow)
     status, modes, fits, details = {}, {}, {}, {}
     identified = {a: pd.read_csv(p) for a, p in zip(names, smk.input.identified)}
     for a, chain in zip(names, smk.input.chain):
@@ -70,7 +71,8 @@ def main(smk) -> None:
     for a, d in diagnosis.items():  # which joint parameters the runs identify at the corrected model's point
         if corrected_holds(d):
             ca = cal.resolved(best[a])
-            data = read_modal(smk.input.modal, a, scatter_csv=smk.input.scatter, damping=ca.damping,
+            unit_modal, unit_scatter = dict(zip(names, smk.input.unit_modal))[a], dict(zip(names, smk.input.unit_scatter))[a]
+            data = read_modal(unit_modal, unit_of(unit_modal)[0], scatter_csv=unit_scatter, damping=ca.damping,
                               floors=dict(post.rel_std_floor))
             theta = [d["recalibrated"]["joint_parameters"][p]["value"] for p in PARAMS]
             corrected[a] = identified_at(theta, data.rel_noise, data.q, ca.space, m=ca.m, model=ca.model,

@@ -28,11 +28,12 @@ def main(smk) -> None:
         s = ValidateSettings.from_config(smk.params.validate)
         best = json.loads(Path(smk.input.best).read_text())
         runs = pd.read_csv(smk.input.runs, dtype={"flags": str})
-        rows = runs[runs["assembly"] == asm].to_dict("records")
-        records = [read_run(listed_record(str(r["file"]), list(smk.input.records)), r) for r in rows]
-        modal_table = pd.read_csv(smk.input.modal)
+        modal_table = pd.read_csv(smk.input.modal)  # this (assembly, mode)'s rows
         modal = modal_table.set_index("run_id")
-        gain = drive_gain(modal_table[modal_table["assembly"] == asm]) if excitation_kind(records[0]) != "base" else None
+        peak = modal["mode_peak_hz"] if "mode_peak_hz" in modal else pd.Series(dtype=float)
+        rows = [{**r, "mode_hz": peak.get(r["run_id"])} for r in runs[runs["run_id"].isin(modal.index)].to_dict("records")]
+        records = [read_run(listed_record(str(r["file"]), list(smk.input.records)), r) for r in rows]
+        gain = drive_gain(modal_table) if excitation_kind(records[0]) != "base" else None
         if gain is not None:  # a force or voltage drives the mode through the campaign's modal constant
             rows = [{**r, "drive_gain": gain} for r in rows]
         models, f_ref = run_models(best, modal["f_res_hz"].to_dict(), [r["run_id"] for r in rows])

@@ -7,12 +7,13 @@ from pathlib import Path
 
 import pandas as pd
 
+from jointcal._workflow import unit_labels
 from jointcal.io import write_bytes_atomic
 from jointcal.report.validation import validation_figure
 
 
 def main(smk) -> None:
-    names = list(smk.params.assemblies)
+    names = unit_labels(smk.input.summary)  # assembly (and mode: jointcal._workflow)
     metrics = {a: pd.read_csv(p) for a, p in zip(names, smk.input.metrics)}
     errors = {a: json.loads(Path(p).read_text())["E"] for a, p in zip(names, smk.input.summary)}
     frames = {a: {p.stem: pd.read_csv(p) for p in sorted(Path(d).glob("*.csv"))} for a, d in zip(names, smk.input.envelopes)}

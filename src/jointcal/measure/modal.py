@@ -61,6 +61,7 @@ FLAG_WORDS = {
                         "is reported at the band-limited envelope peak, usable only for a quasi-steady sweep",
     "units": "the response/base ratio below resonance says the response is in other units than its column "
              "name (ingest's check); the run is left out",
+    "no_mode": "the run's band holds none of the modes found in its assembly's runs (jointcal.measure.modes)",
     "unusable": "no resonance could be estimated from this run",
 }
 
@@ -102,7 +103,8 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
         0.016-0.017 on the real UNESP beam records).
     mode_hz : float, optional
         Approximate natural frequency (Hz) of the mode to read where the band holds more
-        than one: the FRF peak nearest it. Default: for force- and voltage-driven runs the
+        than one: the FRF peak nearest it (`jointcal.measure.campaign` gives each mode's peak
+        in the run, found by `jointcal.measure.modes`). Default: for force- and voltage-driven runs the
         largest peak of the displacement ratio (response / reference / w^2) in the band (a
         higher mode's acceleration peak can be the larger), for base-driven runs the
         envelope peak.

@@ -10,17 +10,20 @@ __all__ = ["scatter"]
 
 
 def scatter(table: pd.DataFrame) -> pd.DataFrame:
-    """Scatter of f_res and damping across repeats and up/down pairs, per assembly.
+    """Scatter of f_res and damping across repeats and up/down pairs, per assembly (and mode, where the
+    table has a ``mode`` column: one row per run and mode, `jointcal.measure.campaign`).
 
-    Rows (assembly, quantity, level, source): 'repeats' for a level run more than twice,
+    Rows (assembly[, mode], quantity, level, source): 'repeats' for a level run more than twice,
     'up_down' for a level with one up/down pair, and one 'pooled' row per (assembly,
     quantity) with the dof-weighted pooled relative standard deviation (level NaN).
     Rows flagged unusable are left out.
     """
     level = level_column(table.columns) or "level_g"
     ok = ~table["flags"].fillna("").str.contains("unusable")
+    keys = ["assembly", "mode"] if "mode" in table.columns else ["assembly"]
     rows = []
-    for (asm), grp in table[ok].groupby("assembly", sort=False):
+    for key, grp in table[ok].groupby(keys, sort=False):
+        unit = dict(zip(keys, key))
         for qty in ("f_res_hz", "zeta_res", "zeta_phase_resonance", "zeta_half_power"):
             if qty not in grp.columns:
                 continue
@@ -31,11 +34,11 @@ def scatter(table: pd.DataFrame) -> pd.DataFrame:
                     continue
                 sd = float(np.std(v, ddof=1))
                 rel = sd / abs(v.mean())
-                rows.append(dict(assembly=asm, quantity=qty, level=lev, source="repeats" if v.size > 2 else "up_down",
+                rows.append(dict(**unit, quantity=qty, level=lev, source="repeats" if v.size > 2 else "up_down",
                                  n=v.size, mean=float(v.mean()), std=sd, rel_std=rel))
                 ss += rel**2 * (v.size - 1)
                 dof += v.size - 1
-            rows.append(dict(assembly=asm, quantity=qty, level=np.nan, source="pooled", n=dof,
+            rows.append(dict(**unit, quantity=qty, level=np.nan, source="pooled", n=dof,
                              mean=np.nan, std=np.nan, rel_std=float(np.sqrt(ss / dof)) if dof else np.nan))
-    out = pd.DataFrame(rows, columns=["assembly", "quantity", "level", "source", "n", "mean", "std", "rel_std"])
+    out = pd.DataFrame(rows, columns=[*keys, "quantity", "level", "source", "n", "mean", "std", "rel_std"])
     return out.rename(columns={"level": level})

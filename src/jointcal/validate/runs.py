@@ -158,7 +158,10 @@ def compare_run(env_m: pd.DataFrame, props_m: Mapping, env_s: pd.DataFrame, prop
 def measure_pair(model: MinistackModel, record: pd.DataFrame, row: Mapping, measured: tuple | None = None, *,
                  envelopes_kw: dict | None = None, modal_kw: dict | None = None, with_record: bool = False):
     """measure_run on the measured record (unless given) and on the model's record: ((env, meta, props) x 2)
-    (and the model's record, with ``with_record``)."""
+    (and the model's record, with ``with_record``). A row's ``mode_hz`` (the frequency the modal stage read
+    the run's mode at, `jointcal.measure.campaign`) overrides the modal options' for both."""
+    if row.get("mode_hz") is not None and np.isfinite(row["mode_hz"]):
+        modal_kw = {**(modal_kw or {}), "mode_hz": float(row["mode_hz"])}
     meas = measured if measured is not None else measure_run(record, dict(row), envelopes_kw=envelopes_kw,
                                                              modal_kw=modal_kw)
     sim_record = simulate_record(model, record, row)

@@ -1,0 +1,166 @@
+"""A campaign's modal table: every run read at every mode its band holds (modal_properties.csv).
+
+The modal stage's steps in the order data flows, on the runs of ``runs.csv``:
+
+1. each force- or voltage-driven run's whole-record FRF gives its resonances
+   (`jointcal.measure.modes.modal_peaks`);
+2. per assembly, the resonances are tracked across the runs into modes, each named by its
+   low-level frequency (`jointcal.measure.modes.track_modes`); ``modal.mode_hz`` restricts them;
+3. each run is read at each mode its band holds (`jointcal.measure.modal.modal_properties`
+   started at the run's own peak of that mode), one row per (run, mode) with the mode in the
+   ``mode`` column.
+
+A base-driven run (the Ministack: one mode in its band) is read as before, at its envelope
+peak (or at each ``modal.mode_hz``), and its mode is named from the read-out at the
+assembly's lowest level. So is every run of an assembly in which no resonance passes the
+tests of `modal_peaks`. A run whose band holds none of its assembly's modes gets one row,
+flagged ``no_mode`` and unusable.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pandas as pd
+
+from ..io._contract import LEVEL, REFERENCE, RESPONSE, excitation_kind
+from .envelopes import ENVELOPE_COLUMNS
+from .frf import displacement_ratio, h1_estimate
+from .modal import modal_properties
+from .modes import mode_name, modal_peaks, track_modes
+
+__all__ = ["campaign_modal", "run_peaks"]
+
+IDENTITY = ("run_id", "assembly", "sequence", "direction")
+
+
+def run_peaks(record: pd.DataFrame, row: dict, kind: str) -> np.ndarray:
+    """The resonances (Hz) of one force- or voltage-driven run's whole-record FRF (`modal_peaks`)."""
+    lo, hi = sorted((float(row["f_start_hz"]), float(row["f_stop_hz"])))
+    if record is None or len(record) < 64:
+        return np.empty(0)
+    tab = h1_estimate(record[REFERENCE[kind]].to_numpy(float), record[RESPONSE].to_numpy(float),
+                      float(row["sample_rate_hz"]))
+    tab = tab[(tab["freq_hz"] >= lo) & (tab["freq_hz"] <= hi)]
+    f = tab["freq_hz"].to_numpy()
+    X = displacement_ratio(f, (tab["h1_re"] + 1j * tab["h1_im"]).to_numpy(), kind)
+    return modal_peaks(f, X, tab["coherence"].to_numpy(), (lo, hi))
+
+
+def _plan(rows: list[dict], records: dict, kind: str, mode_hz) -> list[tuple[dict, object, str | None]]:
+    """(row, start frequency or None, mode name or None: named after reading) per read-out of one assembly."""
+    given = None if mode_hz is None else [float(v) for v in np.atleast_1d(mode_hz)]
+    if kind != "base":
+        peaks = {r["run_id"]: run_peaks(records.get(r["run_id"]), r, kind) for r in rows}
+        bands = {r["run_id"]: (float(r["f_start_hz"]), float(r["f_stop_hz"])) for r in rows}
+        levels = {r["run_id"]: float(r.get(LEVEL[kind], np.nan)) for r in rows}
+        tracked = track_modes(peaks, bands, levels, mode_hz=given)
+        if len(tracked):
+            by_run = {rid: g for rid, g in tracked.groupby("run_id", sort=False)}
+            plan = []
+            for r in rows:
+                g = by_run.get(r["run_id"])
+                if g is None:
+                    plan.append((r, "none", None))
+                else:
+                    plan += [(r, float(t.f_guess_hz), t.mode) for t in g.itertuples()]
+            return plan
+    return [(r, g, None) for g in (given or [None]) for r in rows]
+
+
+def campaign_modal(runs: pd.DataFrame, load: Callable[[dict], tuple], modal_kw: dict | None = None):
+    """Every run read at every mode its band holds.
+
+    Parameters
+    ----------
+    runs : DataFrame
+        ``runs.csv`` of the ingest stage (manifest rows with their flags).
+    load : callable
+        ``load(row) -> (env, meta, record)``: the run's envelopes (DataFrame), their metadata (dict:
+        ``rate_hz_per_s``, ``window_s``, ``error``) and its raw record (DataFrame or None).
+    modal_kw : dict, optional
+        The config's ``modal`` section (`modal_properties`' keywords; ``mode_hz`` a number, a list or None).
+
+    Returns
+    -------
+    rows : list of dict
+        One row of modal_properties.csv per (run, mode), with ``mode`` (empty where a run was read at none)
+        and ``mode_peak_hz`` (the frequency the read-out started at: the run's own peak of the mode, or
+        ``modal.mode_hz``; NaN where it started at the envelope peak or the band's largest peak).
+    frf : dict of run_id to DataFrame
+        Each run's FRF (`jointcal.measure.frf.record_frf`'s table on the record's independent lines, the
+        zero-padding's interpolated lines left out), one table per mode read, with a ``mode`` column.
+    notes : list of str
+        Sentences for the log (envelope errors).
+    """
+    kw = dict(modal_kw or {})
+    mode_hz = kw.pop("mode_hz", None)
+    loaded, rows, frf, notes = {}, [], {}, []
+    for row in runs.to_dict("records"):
+        env, meta, record = load(row)
+        if meta.get("error") and record is None:
+            rows.append({**{k: row.get(k) for k in IDENTITY}, "mode": "", "flags": "unusable"})
+            notes.append(f"{row['run_id']}: {meta['error']}")
+            continue
+        if meta.get("error"):  # no envelopes: the whole-record FRF alone
+            env = pd.DataFrame(columns=list(ENVELOPE_COLUMNS))
+            notes.append(f"{row['run_id']}: {meta['error']} (the resonance comes from the whole-record FRF)")
+        loaded[row["run_id"]] = (row, env, meta, record)
+    for _, group in pd.DataFrame([v[0] for v in loaded.values()] or [{}]).groupby("assembly", sort=False):
+        grows = group.to_dict("records")
+        first = loaded[grows[0]["run_id"]]
+        kind = excitation_kind([*(first[3].columns if first[3] is not None else []), *first[0]])
+        read = []
+        for row, guess, name in _plan(grows, {r: v[3] for r, v in loaded.items()}, kind, mode_hz):
+            _, env, meta, record = loaded[row["run_id"]]
+            if guess == "none":
+                rows.append({**{k: row.get(k) for k in IDENTITY}, "mode": "", "flags": "no_mode;unusable"})
+                continue
+            rate = meta.get("rate_hz_per_s", row["sweep_rate_hz_per_s"])
+            out, tab = modal_properties(env, row, rate_hz_per_s=rate, record=record, with_frf=True,
+                                        mode_hz=guess, **kw)
+            out["window_s"] = meta.get("window_s")
+            out["mode_peak_hz"] = float(guess) if guess is not None else float("nan")
+            read.append((out, tab, guess, name))
+        _name_modes(read, kind)
+        for out, tab, _, _ in read:
+            rows.append(out)
+            if len(tab):
+                frf.setdefault(out["run_id"], []).append(_independent_lines(tab, loaded[out["run_id"]]).assign(
+                    mode=out["mode"]))
+    order = {r: i for i, r in enumerate(runs["run_id"])}
+    rows.sort(key=lambda o: order.get(o["run_id"], -1))
+    return rows, {r: pd.concat(t, ignore_index=True) for r, t in frf.items()}, notes
+
+
+def _independent_lines(tab: pd.DataFrame, loaded: tuple) -> pd.DataFrame:
+    """Every line of a zero-padded FRF that is independent (spacing 1 / record length)."""
+    row, record = loaded[0], loaded[3]
+    df_line = tab["freq_hz"].iloc[1] - tab["freq_hz"].iloc[0]
+    pad = max(1, int(round(float(row["sample_rate_hz"]) / len(record) / df_line)))
+    return tab.iloc[::pad].reset_index(drop=True)
+
+
+def _name_modes(read: list, kind: str) -> None:
+    """Set each read-out's ``mode``: the tracked name, or (no tracking) the name of its start's
+    read-outs at the lowest level; names made unique within the assembly."""
+    level = LEVEL[kind]
+    for key in dict.fromkeys(g for _, _, g, n in read if n is None):
+        outs = [o for o, _, g, n in read if n is None and g == key]
+        usable = [o for o in outs if "unusable" not in o["flags"] and np.isfinite(o.get("f_res_hz", np.nan))]
+        low = min(usable or outs, key=lambda o: (o.get(level, np.inf), str(o["run_id"])))
+        f = low.get("f_res_hz", np.nan)
+        name = mode_name(f) if np.isfinite(f) else (mode_name(key) if key is not None else "m0")
+        for o in outs:
+            o["mode"] = name
+    for o, _, _, n in read:
+        if n is not None:
+            o["mode"] = n
+    keys = {}
+    for o, _, g, n in read:  # a tracked mode is one mode whatever its runs' peaks; an untracked one, its start
+        keys.setdefault(o["mode"], set()).add(n if n is not None else g)
+    for name, k in keys.items():
+        if len(k) > 1:  # two modes under one name (e.g. 95.2 and 95.8 Hz): the start frequency tells them apart
+            for o, _, g, n in read:
+                if o["mode"] == name and g is not None:
+                    o["mode"] = f"{name}_{float(g):.1f}".replace(".", "p")
