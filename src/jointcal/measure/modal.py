@@ -61,6 +61,8 @@ FLAG_WORDS = {
                         "is reported at the band-limited envelope peak, usable only for a quasi-steady sweep",
     "units": "the response/base ratio below resonance says the response is in other units than its column "
              "name (ingest's check); the run is left out",
+    "dead": "the response does not respond to the drive (an offset and noise: a dead or unplugged sensor; "
+            "ingest's check); the run is left out",
     "unusable": "no resonance could be estimated from this run",
 }
 
