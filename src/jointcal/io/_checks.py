@@ -71,7 +71,9 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
         (which a free-decay tail may follow), each referred to that instant with the
         manifest's sweep rate (Hz); ``f_tolerance_hz``, the allowed deviation from
         ``f_start_hz``/``f_stop_hz`` (Hz) (the three NaN when the reference holds no
-        signal); ``flags``, a list such as ``['nonfinite:response_accel_g',
+        signal); ``response_units_check``, what the base-driven response-units check
+        found, in words: '<unit> confirmed: ...', 'flagged: ...', 'undecided: <why>' or
+        'not checkable: ...' (force- and voltage-driven); ``flags``, a list such as ``['nonfinite:response_accel_g',
         'clipped:base_accel_g']``; the words are ``nonfinite``, ``constant``,
         ``clipped``, ``swapped``, ``level``, ``units`` and ``dead`` (a response that
         does not follow the drive, `jointcal.io._dead`) (see `UNUSABLE_FLAGS`).
@@ -143,14 +145,18 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
     if not silent and not swapped:
         _report(dead_problem(chans[ref], chans[RESPONSE], fs, f0, f1, rate, path, drop,
                              df.attrs.get("sources", {}).get(RESPONSE, {})), flags, on_data_problem)
+    units_note = "undecided: the channels are silent or swapped"
     if not silent and not swapped and not any(f.startswith("dead:") for f in flags):
-        _report(level_problems(chans, amp, kind, row, fs, path, run, drop, df.attrs.get("sources", {})), flags,
-                on_data_problem)
+        problems, units_note = level_problems(chans, amp, kind, row, fs, path, run, drop, df.attrs.get("sources", {}))
+        _report(problems, flags, on_data_problem)
+    elif any(f.startswith("dead:") for f in flags):
+        units_note = "undecided: the response does not respond to the drive"
     rms = {f"rms_{c}": float("nan") for c in (*REFERENCE.values(), RESPONSE)}
     rms.update({f"rms_{c}": float(np.sqrt(np.mean(x[np.isfinite(x)] ** 2))) for c, x in chans.items()
                 if np.isfinite(x).any()})
     return {"n_samples": t.size, "duration_s": t.size / fs, "fs_measured_hz": fs, "excitation": kind, **rms,
-            "f_first_hz": f_first, "f_last_hz": f_last, "f_tolerance_hz": tol, "flags": flags}
+            "f_first_hz": f_first, "f_last_hz": f_last, "f_tolerance_hz": tol, "response_units_check": units_note,
+            "flags": flags}
 
 
 def _data_problems(t: NDArray[np.float64], chans: dict[str, NDArray[np.float64]], clip_run: int,

@@ -10,7 +10,7 @@ from collections.abc import Mapping
 import numpy as np
 from numpy.typing import NDArray
 
-from jointcal.io._amplitudes import _quadrature, _sums, _windows
+from jointcal.io._windows import quadrature, sums, windows
 from jointcal.io._contract import RESPONSE
 
 __all__ = ["drive_share", "dead_problem", "DEAD_SHARE"]
@@ -43,13 +43,13 @@ def drive_share(drive: NDArray[np.float64], resp: NDArray[np.float64], fs: float
         to window. Noise alone gives about 2 / (samples per window). NaN when the sweep holds
         no whole window.
     """
-    k, m = _windows(drive.size, fs, f0, f1, rate)
+    k, m = windows(drive.size, fs, f0, f1, rate)
     if m < 1:
         return float("nan")
     x = np.nan_to_num(drive - np.nanmedian(drive))
-    hx = _quadrature(x)
+    hx = quadrature(x)
     y = np.nan_to_num(resp - np.nanmedian(resp))[: x.size]
-    n, a11, a12, a22, b1, b2, s1, s2 = _sums(k, m, np.ones(k.size), x * x, x * hx, hx * hx, x * y, hx * y, y, y * y)
+    n, a11, a12, a22, b1, b2, s1, s2 = sums(k, m, np.ones(k.size), x * x, x * hx, hx * hx, x * y, hx * y, y, y * y)
     det = a11 * a22 - a12**2
     with np.errstate(divide="ignore", invalid="ignore"):
         a = (a22 * b1 - a12 * b2) / det
