@@ -149,10 +149,14 @@ def level_problems(chans: Mapping[str, NDArray[np.float64]], amp: Mapping[str, N
         declared = sources.get(RESPONSE, {}).get("unit", "g")
         note = (f"{declared} confirmed: response/base {low.scale:.3g} below resonance (at {low.f_low:.0f} Hz, one "
                 f"mode's rise removed)")
-        if not (base_scale != 1.0 and abs(np.log(scale / base_scale)) <= np.log(RESPONSE_UNIT_BAND)):
+        if base_scale != 1.0 and abs(np.log(scale / base_scale)) <= np.log(RESPONSE_UNIT_BAND):
+            note = (f"flagged with the base: response/base {low.scale:.3g} below resonance (at {low.f_low:.0f} Hz), "
+                    "one unit for both")
+        else:
             found = _response_units(scale, low, sources.get(RESPONSE, {}), path, drop)
             out += found
-            note = f"flagged: response/base {low.scale:.3g} below resonance (at {low.f_low:.0f} Hz)" if found else note
+            if found:
+                note = f"flagged: response/base {low.scale:.3g} below resonance (at {low.f_low:.0f} Hz)"
     return out, note
 
 
