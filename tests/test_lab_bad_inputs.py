@@ -25,7 +25,7 @@ RUN, OTHER = "first_01_1g_up", "first_07_2g_up"
 
 
 def _ingest(campaign: Path, capsys) -> tuple[int, list[str], pd.DataFrame | None]:
-    """Exit status, stderr lines and runs.csv (None when not written) of `jointcal ingest ... --on-data-problem flag`."""
+    """Exit status, stderr lines and runs.csv (None when not written) of `jointcal ingest --on-data-problem flag`."""
     out = campaign.parent / "results" / "runs.csv"
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", CampaignWarning)
@@ -166,8 +166,9 @@ def test_a_dead_accelerometer_is_flagged_and_left_out(tmp_path, voltage, capsys,
     assert len(lines) == 1, lines
     msg = lines[0].removeprefix("jointcal: warning: ")
     assert msg.startswith(f"{path}: column 'response_accel_g' (channel 'Time Acc' of the file) does not respond to "
-                          "the drive") and "an offset and noise" in msg and "check the accelerometer, its cable" in msg \
-        and f"or remove run '{rid}' from manifest.csv" in msg and msg.endswith("."), msg
+                          "the drive"), msg
+    assert "an offset and noise" in msg and "check the accelerometer, its cable" in msg, msg
+    assert f"or remove run '{rid}' from manifest.csv" in msg and msg.endswith("."), msg
     assert "dead" in UNUSABLE_FLAGS and "unusable" in run_flags(runs.loc[rid, "flags"], "low_snr", rid)[0]
 
 
@@ -190,7 +191,7 @@ def test_noise_alone_follows_the_drive_by_two_coefficients_per_window():
 REAL_CHIRPS = REPO.parent / "shared" / "real" / "unesp-bert-mode1"
 
 
-@pytest.mark.skipif(not REAL_CHIRPS.is_dir(), reason=f"the real UNESP chirps are not at {REAL_CHIRPS} (never committed)")
+@pytest.mark.skipif(not REAL_CHIRPS.is_dir(), reason=f"the real UNESP chirps are not at {REAL_CHIRPS} (not committed)")
 def test_the_dead_check_has_no_false_positive_on_real_fast_chirps():
     """The UNESP beam's 5 Hz/s chirps ring at their mode after its passage: 15-20 % of the response follows the
     drive window by window, 80-110 times what noise alone gives (0.19 %); no run is flagged."""

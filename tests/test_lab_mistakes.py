@@ -109,6 +109,7 @@ def test_a_base_in_m_s2_beside_a_right_m_s2_response_converts_only_the_base(exam
                     "leave the response as it is")
     assert "export base_accel_g and response_accel_g" not in capsys.readouterr().err
     assert runs.loc[OTHER, "flags"] == ""
+    assert runs.loc[RUN, "response_units_check"].startswith("m/s^2 confirmed: response/base 0.102")
 
 
 def test_both_channels_in_m_s2_are_converted_together(example):
@@ -118,6 +119,11 @@ def test_both_channels_in_m_s2_are_converted_together(example):
         ingest_campaign(example)
     _one_sentence(str(info.value), FILE, "is the record in m/s^2?",
                   "export base_accel_g and response_accel_g in g (divide by 9.80665)")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", CampaignWarning)
+        runs = ingest_campaign(example, on_data_problem="flag").set_index("run_id")
+    assert runs.loc[RUN, "flags"] == "level:base_accel_g"
+    assert runs.loc[RUN, "response_units_check"].startswith("flagged with the base: response/base 1 below")
 
 
 # the issue-32 rig: the reassembly (beta 0.025, the most damped joint) swept fast (1000 Hz/s: eta_high), so at

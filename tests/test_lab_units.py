@@ -185,6 +185,38 @@ def test_a_uff_response_said_only_by_its_exponents_and_data_set_164_is_read_righ
     assert (ingest_campaign(voltage)["flags"] == "").all()
 
 
+def test_a_base_driven_uff_in_si_said_only_by_exponents_and_data_set_164_is_read_right(tmp_path):
+    """Both accelerations in m/s^2 (length exponent 1, data set 164 SI, no label): formerly read as g, 9.81x, and
+    caught only by the level check; now the CSV's g, no flag."""
+    from _campaign import example_copy
+
+    campaign = example_copy(tmp_path / "c", "first_01_1g_up", "first_07_2g_up")
+    row = read_manifest(campaign / "manifest.csv").iloc[0].to_dict()
+    df = read_run(campaign / row["file"], row)
+    t = df["time_s"].to_numpy()
+    sets = [pyuff.prepare_164(units_code=1, units_description="SI", temp_mode=1, length=1.0, force=1.0, temp=1.0,
+                              temp_offset=273.15)]
+    for i, (name, col) in enumerate((("Time Drive", "base_accel_g"), ("Time Acc", "response_accel_g"))):
+        sets.append(pyuff.prepare_58(
+            binary=1, id1=name, func_type=1, rsp_node=i + 1, rsp_dir=3, ref_node=0, ref_dir=0,
+            data=df[col].to_numpy() * G_SI, x=t, abscissa_spacing=1, abscissa_spec_data_type=17,
+            abscissa_axis_units_lab="s", ordinate_spec_data_type=12, ordinate_len_unit_exp=1,
+            ordinate_force_unit_exp=0, ordinate_temp_unit_exp=0, ordinate_axis_units_lab="NONE",
+            orddenom_spec_data_type=0, z_axis_spec_data_type=0))
+    file = row["file"].replace(".csv.gz", ".uff")
+    pyuff.UFF(str(campaign / file)).write_sets(sets, "add")
+    edit_manifest(campaign, lambda m: m.assign(
+        file=m["file"].where(m["run_id"] != row["run_id"], file),
+        reference_channel=np.where(m["run_id"] == row["run_id"], "Time Drive", ""),
+        response_channel=np.where(m["run_id"] == row["run_id"], "Time Acc", "")))
+    got = read_run(campaign / file, read_manifest(campaign / "manifest.csv").iloc[0].to_dict())
+    for col in ("base_accel_g", "response_accel_g"):
+        np.testing.assert_allclose(got[col], df[col], rtol=1e-12, atol=1e-15)
+    runs = ingest_campaign(campaign)
+    assert (runs["flags"] == "").all()
+    assert list(runs["response_units_check"].str.split(":").str[0]) == ["m/s^2 confirmed", "g confirmed"]
+
+
 def test_a_uff_label_that_disagrees_with_its_exponents_is_named(voltage):
     """Label 'g' on values that length exponent 1 and data set 164 (SI) make m/s^2: one of them is wrong."""
     path, row, _ = _as_lab_run(voltage, ".uff", lambda p, d: write_uff_units(p, d, 1, response_label="g"))

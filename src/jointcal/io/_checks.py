@@ -26,9 +26,9 @@ from jointcal.io._time import check_time, time_resolution
 
 __all__ = ["validate_run", "clipped_mask", "clip_levels", "window_amplitudes", "time_resolution", "UNUSABLE_FLAGS"]
 
-# ingest flags whose run must not enter a calibration: its amplitudes or channels are wrong, or
-# it is clipped, or its response does not respond to the drive (dead) (a linear SDOF clipped at 95-60 % of its resonance peak gives damping 14-138 %
-# high even with the frames touching clipped samples left out: the peak itself is missing)
+# ingest flags whose run must not enter a calibration: its amplitudes or channels are wrong, its response does
+# not respond to the drive (dead), or it is clipped (a linear SDOF clipped at 95-60 % of its resonance peak gives
+# damping 14-138 % high even with the frames touching clipped samples left out: the peak itself is missing)
 UNUSABLE_FLAGS = ("level", "units", "swapped", "constant", "clipped", "dead")
 
 

@@ -78,6 +78,7 @@ def dead_problem(drive: NDArray[np.float64], resp: NDArray[np.float64], fs: floa
     finite = resp[np.isfinite(resp)]
     return [(f"dead:{RESPONSE}",
              f"{path}: column '{RESPONSE}'{said} does not respond to the drive ({share:.1%} of its power over the "
-             f"sweep follows it, as noise alone would ({noise:.1%}); it reads {np.mean(finite):.3g} g +/- {np.std(finite):.3g} g, "
+             f"sweep follows it, as noise alone would ({noise:.1%}); it reads {np.mean(finite):.3g} g "
+             f"+/- {np.std(finite):.3g} g, "
              f"an offset and noise); check the accelerometer, its cable and the channel's assignment and repeat "
              f"the run {drop}.")]

@@ -167,7 +167,8 @@ def uff_unit(s: Mapping[str, Any], units164: Mapping[str, Any] | None, where: ob
     if length <= 0 or force <= 0:
         fail(where, f"its data set 164 gives the unit factors length {length:g}, force {force:g}",
              "export the file with its unit system's factors (SI: 1 and 1)")
-    said = "its unit exponents and data set 164" if units164 else "its unit exponents (SI: the file has no data set 164)"
+    said = "its unit exponents and data set 164" if units164 else \
+        "its unit exponents (SI: the file has no data set 164)"
     unit = SI_UNIT[quantity]
     _check_label(shown, quantity, unit, said, where, name)
     return 1.0 / (length ** exps[0] * force ** exps[1]), unit, quantity, said

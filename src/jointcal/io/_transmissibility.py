@@ -115,8 +115,8 @@ def response_ratio(ref: NDArray[np.float64], resp: NDArray[np.float64], fs: floa
     beyond = k == f.size - 1
     f_peak = float(f[k])
     if beyond and f_low > BEYOND_MAX * f_peak:
-        return (f"the ratio still rises at the band's top ({f_peak:.0f} Hz) and the band starts at {f_low / f_peak:.2f} "
-                f"of it (the resonance's rise there is unknown)")
+        return (f"the ratio still rises at the band's top ({f_peak:.0f} Hz) and the band starts at "
+                f"{f_low / f_peak:.2f} of it (the resonance's rise there is unknown)")
     if not beyond and f_low > LOW_RATIO_MAX * f_peak:
         return f"the band starts at {f_low / f_peak:.2f} of the resonance ({f_peak:.0f} Hz), above {LOW_RATIO_MAX}"
     below = (f <= f_low + QUASI_STATIC * (f_peak - f_low)) & (f < f_peak)
