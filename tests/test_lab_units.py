@@ -154,9 +154,10 @@ UNIT_CODES = {1: (1.0, 1.0), 2: (1 / (12 * INCH_M), 1 / LBF_N), 5: (1e3, 1e3), 7
               9: (250.0, 3.0)}
 
 
-def write_uff_units(path: Path, df: pd.DataFrame, code: int | None, *, response_label: str = "NONE") -> None:
+def write_uff_units(path: Path, df: pd.DataFrame, code: int | None, *, response_label: str = "NONE",
+                    exponent: int = 1) -> None:
     """The drive (V, by its label) and the response in the length unit of units `code`, said by its exponents
-    (length 1, force 0; acceleration) and data set 164 (none when `code` is None), written by pyuff."""
+    (length `exponent`, force 0; acceleration, type 12) and data set 164 (none when `code` is None), by pyuff."""
     length, force = UNIT_CODES[code or 1]
     t = df["time_s"].to_numpy()
     sets = [] if code is None else [pyuff.prepare_164(units_code=code, units_description=f"code {code}",
@@ -164,7 +165,7 @@ def write_uff_units(path: Path, df: pd.DataFrame, code: int | None, *, response_
                                                       temp_offset=273.15)]
     for i, (name, values, kind, exp, lab) in enumerate((
             ("Time Drive", df["drive_V"].to_numpy(), 0, 0, "V"),
-            ("Time Acc", df["response_accel_g"].to_numpy() * G_SI * length, 12, 1, response_label))):
+            ("Time Acc", df["response_accel_g"].to_numpy() * G_SI * length, 12, exponent, response_label))):
         sets.append(pyuff.prepare_58(
             binary=1, id1=name, func_type=1, rsp_node=i + 1, rsp_dir=3, ref_node=0, ref_dir=0, data=values, x=t,
             abscissa_spacing=1, abscissa_spec_data_type=17, abscissa_axis_units_lab="s", abscissa_len_unit_exp=0,
@@ -215,6 +216,15 @@ def test_a_base_driven_uff_in_si_said_only_by_exponents_and_data_set_164_is_read
     runs = ingest_campaign(campaign)
     assert (runs["flags"] == "").all()
     assert list(runs["response_units_check"].str.split(":").str[0]) == ["m/s^2 confirmed", "g confirmed"]
+
+
+@pytest.mark.parametrize("code", [1, 5, 7])
+def test_a_uff_acceleration_with_exponents_0_is_read_in_the_system_of_data_set_164(voltage, code):
+    """pyuff's default exponents (0) on a type-12 record without a label, in a file with data set 164: the
+    acceleration's dimensions (length / s^2) in that system, not the contract's g."""
+    path, row, df = _as_lab_run(voltage, ".uff", lambda p, d: write_uff_units(p, d, code, exponent=0))
+    np.testing.assert_allclose(read_run(path, row)["response_accel_g"], df["response_accel_g"], rtol=1e-12,
+                               atol=1e-15)
 
 
 def test_a_uff_label_that_disagrees_with_its_exponents_is_named(voltage):

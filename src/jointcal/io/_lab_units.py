@@ -10,7 +10,9 @@ Private: the readers of `jointcal.io._lab_channels` call `testlab_unit` and `uff
   specific data type (12 acceleration, 11 velocity, 8 displacement, 9 and 13 force)
   give the dimensions, in the file's unit system: data set 164's factors convert it to
   SI (divide by length^e_length x force^e_force); a file without data set 164 is taken
-  in SI. All exponents 0 say nothing (pyuff's default); the units label is then read.
+  in SI. All exponents 0 say nothing (pyuff's default): the units label is then read;
+  without a label, a file with data set 164 gives the data type's dimensions in its
+  system (exponents 0 on an acceleration are a writer's default, not a dimension).
 
 A label that names a unit of other dimensions than the stored quantity, or of another
 size than the stored unit, is named (`fail`): one of the two is wrong, and the reader
@@ -154,8 +156,12 @@ def uff_unit(s: Mapping[str, Any], units164: Mapping[str, Any] | None, where: ob
     quantity = UFF_QUANTITY.get(int(s.get("ordinate_spec_data_type", 0) or 0))
     shown = label(s.get("ordinate_axis_units_lab"))
     exps = (int(s.get("ordinate_len_unit_exp", 0) or 0), int(s.get("ordinate_force_unit_exp", 0) or 0))
-    if exps == (0, 0):  # the exponents say nothing: the label is the unit
-        return 1.0, (shown if shown and unit_size(shown) else shown), quantity, "its units label"
+    said = "its unit exponents and data set 164" if units164 else \
+        "its unit exponents (SI: the file has no data set 164)"
+    if exps == (0, 0) and (shown or units164 is None or quantity not in UFF_EXPONENTS):
+        return 1.0, shown, quantity, "its units label"  # the exponents say nothing: the label is the unit
+    if exps == (0, 0):  # no label, exponents 0, but a unit system: the data type's dimensions in it
+        exps, said = UFF_EXPONENTS[quantity], "its data type and data set 164 (its unit exponents are 0)"
     if quantity is None and exps == (1, 0):  # a general record in length / time^k: the contract reads accelerations
         quantity = "acceleration"
     if quantity not in UFF_EXPONENTS or UFF_EXPONENTS[quantity] != exps:
@@ -167,8 +173,6 @@ def uff_unit(s: Mapping[str, Any], units164: Mapping[str, Any] | None, where: ob
     if length <= 0 or force <= 0:
         fail(where, f"its data set 164 gives the unit factors length {length:g}, force {force:g}",
              "export the file with its unit system's factors (SI: 1 and 1)")
-    said = "its unit exponents and data set 164" if units164 else \
-        "its unit exponents (SI: the file has no data set 164)"
     unit = SI_UNIT[quantity]
     _check_label(shown, quantity, unit, said, where, name)
     return 1.0 / (length ** exps[0] * force ** exps[1]), unit, quantity, said
