@@ -14,7 +14,7 @@ import pyuff
 import scipy.io
 from _campaign import REPO, example_copy
 from nptdms import ChannelObject, GroupObject, TdmsWriter
-from test_lab_units import DIMS, _as_lab_run, _quantity, write_testlab_mks, write_uff_units
+from test_lab_units import DIMS, REAL, _as_lab_run, _quantity, write_testlab_mks, write_uff_units
 
 from jointcal.cli import main
 from jointcal.io import CampaignWarning, UNUSABLE_FLAGS, read_manifest, read_run
@@ -188,7 +188,7 @@ def test_noise_alone_follows_the_drive_by_two_coefficients_per_window():
     assert drive_share(drive, 3.0 * drive + 0.2, *args)[0] == pytest.approx(1.0, abs=1e-9)
 
 
-REAL_CHIRPS = REPO.parent / "shared" / "real" / "unesp-bert-mode1"
+REAL_CHIRPS = REAL.parent / "unesp-bert-mode1"
 
 
 @pytest.mark.skipif(not REAL_CHIRPS.is_dir(), reason=f"the real UNESP chirps are not at {REAL_CHIRPS} (not committed)")

@@ -1,7 +1,8 @@
 """Units as each lab format stores them (jointcal.io._lab_units), on files the project's writer did not make:
 Test.Lab MATLAB exports saved in MKS (the lab's own five dwells, opt-in, and structs written here with scipy.io
 the way Test.Lab writes them), UFF 58 whose unit is said by its exponents and data set 164 (pyuff, each unit
-code), and labels that disagree with the stored quantity."""
+code), and labels that disagree with the stored quantity. The real files are read from ../shared/real/ (or the
+folder JOINTCAL_REAL_DATA names); the tests that need them skip, with the reason, when they are absent."""
 from __future__ import annotations
 
 import os
