@@ -109,6 +109,7 @@ def test_a_base_in_m_s2_beside_a_right_m_s2_response_converts_only_the_base(exam
                     "leave the response as it is")
     assert "export base_accel_g and response_accel_g" not in capsys.readouterr().err
     assert runs.loc[OTHER, "flags"] == ""
+    assert runs.loc[RUN, "response_units_check"].startswith("m/s^2 confirmed: response/base 0.102")
 
 
 def test_both_channels_in_m_s2_are_converted_together(example):
@@ -118,6 +119,94 @@ def test_both_channels_in_m_s2_are_converted_together(example):
         ingest_campaign(example)
     _one_sentence(str(info.value), FILE, "is the record in m/s^2?",
                   "export base_accel_g and response_accel_g in g (divide by 9.80665)")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", CampaignWarning)
+        runs = ingest_campaign(example, on_data_problem="flag").set_index("run_id")
+    assert runs.loc[RUN, "flags"] == "level:base_accel_g"
+    assert runs.loc[RUN, "response_units_check"].startswith("flagged with the base: response/base 1 below")
+
+
+# the issue-32 rig: the reassembly (beta 0.025, the most damped joint) swept fast (1000 Hz/s: eta_high), so at
+# 10 g its response peaks at the band's top; levels in the test order 1, 10, 5, ... g, up and down in turn
+FAST_SERIES = [{"level_g": lv, "directions": [d]} for lv, d in zip((1.0, 10.0, 5.0), ("up", "up", "down"))]
+REASSEMBLY = {"Fs": 274.0, "KT": 0.90e6, "chi": -0.61, "beta": 0.025, "k": 8.56e5, "zeta_v": 0.0017}
+
+
+@pytest.fixture(scope="module")
+def fast_campaigns(tmp_path_factory) -> dict[int, Path]:
+    """Base-driven synthetic campaigns of 2 and 3 runs (`FAST_SERIES`), made once (read only)."""
+    from jointcal.synth import generate
+
+    out = {}
+    for n in (2, 3):
+        folder = tmp_path_factory.mktemp(f"fast{n}")
+        spec = {"seed": 11 + n, "sweep": {"rate_hz_per_s": 1000.0}, "series": FAST_SERIES[:n],
+                "assemblies": {"reassembly": REASSEMBLY}}
+        generate(spec, folder / "c", folder / "truth.json")
+        out[n] = folder / "c"
+    return out
+
+
+CAMPAIGN_POSITIONS = [(2, 0), (2, 1), (3, 0), (3, 1), (3, 2)] + [
+    pytest.param(24, i, marks=() if i in (0, 1, 12, 23) else pytest.mark.slow) for i in range(24)]
+
+
+@pytest.mark.parametrize("n, position", CAMPAIGN_POSITIONS)
+def test_a_response_in_m_s2_under_the_g_name_is_flagged_in_a_campaign_of_any_size(tmp_path, fast_campaigns, capsys,
+                                                                                   n, position):
+    """One run's response exported in m/s^2 under the g name (x9.80665), at each position of a campaign of 2, 3
+    (synthetic, the issue's fast-swept damped joint, whose 10 g response peaks at the band's top) or 24 runs (the
+    example): that run alone is flagged with one sentence naming its file, the run and the fix; every other run's
+    row says its g was confirmed."""
+    import shutil
+
+    src = REPO / "raw_data" if n == 24 else fast_campaigns[n]
+    campaign = Path(shutil.copytree(src, tmp_path / "c", ignore=shutil.ignore_patterns("*.yaml", "README.md")))
+    row = read_manifest(campaign / "manifest.csv").iloc[position]
+    assert len(read_manifest(campaign / "manifest.csv")) == n
+    edit_run(campaign, row["file"], _scale("response_accel_g", G_SI))
+    runs = _flagged(campaign, capsys, row["run_id"], "units:response_accel_g", f"{row['file']}: below resonance",
+                    "the response read from 'response_accel_g' as g is", "is it in m/s^2?",
+                    "name the column response_accel_m_s2 (it holds m/s^2) or export it in g",
+                    f"or remove run '{row['run_id']}' from manifest.csv")
+    assert runs.loc[row["run_id"], "response_units_check"].startswith("flagged: response/base")
+    assert runs.drop(index=row["run_id"])["response_units_check"].str.startswith("g confirmed").all()
+
+
+def test_the_issue_campaign_is_read_from_the_ratio_below_a_resonance_above_the_band(fast_campaigns):
+    """The 2-run campaign's 10 g run peaks at the band's last window: the resonance is at or above 2.5 kHz, so the
+    ratio at 741 Hz holds one mode's rise of at most 1/(1 - (741/2496)^2) = 1.097: the response's scale lies in
+    [ratio / 1.097, ratio], which holds 1 (g) within 2 % (the example's spread) where m/s^2 would give 9.8."""
+    from jointcal.io._transmissibility import response_ratio
+
+    row = read_manifest(fast_campaigns[2] / "manifest.csv").iloc[1]
+    df = read_run(fast_campaigns[2] / row["file"], row)
+    low = response_ratio(df["base_accel_g"].to_numpy(), df["response_accel_g"].to_numpy(), row["sample_rate_hz"],
+                         row["f_start_hz"], row["f_stop_hz"], row["sweep_rate_hz_per_s"])
+    assert low.beyond and low.f_peak > 0.99 * row["f_stop_hz"]
+    assert low.rise == pytest.approx(1 / (1 - (low.f_low / low.f_peak) ** 2)) and low.rise < 1.1
+    assert low.ratio / low.rise <= 1.02 and low.ratio >= 0.98
+    assert low.ratio / low.rise <= low.scale <= low.ratio
+
+
+def test_a_run_whose_record_cannot_tell_its_response_units_says_so_in_its_row(tmp_path, voltage):
+    """A band that starts at 0.9 of the resonance (2000-2500 Hz around 2.26 kHz): no quasi-static ratio, so the
+    row says 'undecided' and why; a voltage-driven run: 'not checkable'."""
+    from jointcal.synth import generate
+
+    spec = {"seed": 21, "sweep": {"f_start_hz": 2000.0, "f_stop_hz": 2500.0, "rate_hz_per_s": 300.0},
+            "series": [{"level_g": 1.0, "directions": ["up"]}],
+            "assemblies": {"first": {"Fs": 313.0, "KT": 1.02e6, "chi": -0.65, "beta": 0.004, "k": 6.12e5,
+                                     "zeta_v": 0.0015}}}
+    generate(spec, tmp_path / "near", tmp_path / "truth.json")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        near = ingest_campaign(tmp_path / "near")
+        volt = ingest_campaign(voltage)
+    assert near.loc[0, "flags"] == ""
+    assert near.loc[0, "response_units_check"].startswith("undecided: the band starts at 0.")
+    assert "of the resonance" in near.loc[0, "response_units_check"]
+    assert volt["response_units_check"].str.startswith("not checkable: a voltage-driven record").all()
 
 
 def test_units_check_has_no_false_positive_on_the_example_runs():
@@ -131,7 +220,8 @@ def test_units_check_has_no_false_positive_on_the_example_runs():
         assert ratio * (1 - (f_low / f_peak) ** 2) == pytest.approx(1.0, abs=0.02), row["run_id"]
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        assert (ingest_campaign(REPO / "raw_data")["flags"] == "").all()
+        runs = ingest_campaign(REPO / "raw_data")
+    assert (runs["flags"] == "").all() and runs["response_units_check"].str.startswith("g confirmed").all()
 
 
 EFFECT_CASES = [(e, {}) for e in ("none", "fixture_flexibility", "channel_delay", "cubic_stiffening",

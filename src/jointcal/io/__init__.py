@@ -17,10 +17,15 @@ Modules, in the order a record flows through them:
 * `_manifest`: ``manifest.csv``, every row checked (`read_manifest`).
 * `_records`: one record, the contract's CSV or MAT (`read_run`), a whole campaign
   (`ingest_campaign`), a manifest file among a rule's inputs (`listed_record`).
-* `_lab_formats`: UFF 58, TDMS and Test.Lab exports, units converted to the contract's.
+* `_lab_formats`: UFF 58, TDMS and Test.Lab exports, units converted to the contract's;
+  `_lab_channels` reads each format's channels (a file cut short, a sample interval that
+  is not positive), `_lab_units` their units as the format stores them (Test.Lab's MKS,
+  UFF 58's exponents and data set 164).
 * `_checks`: one record against its manifest row (`validate_run`), with `_time` (the time
-  axis), `_band` (the drive's band), `_amplitudes` (swapped channels, level, units) and
-  `_clipping` (samples at an ADC's full scale).
+  axis), `_band` (the drive's band), `_amplitudes` (swapped channels, level, units; over
+  `_windows` of 20 drive cycles), `_transmissibility` (a base-driven response's scale from
+  its ratio to the base below resonance), `_dead` (a response that does not follow the
+  drive) and `_clipping` (samples at an ADC's full scale).
 * `_atomic`: writers that never leave half a file.
 """
 from __future__ import annotations

@@ -12,7 +12,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from jointcal.io._contract import LEVEL, MIN_CYCLES, QUANTITY, REFERENCE, RESPONSE, UNITS
+from jointcal.io._contract import LEVEL, QUANTITY, REFERENCE, RESPONSE, UNITS
+from jointcal.io._transmissibility import LowRatio, low_frequency_ratio, response_ratio
+from jointcal.io._windows import sums, windows
 
 __all__ = ["window_amplitudes", "swap_problem", "level_problems", "low_frequency_ratio"]
 
@@ -20,31 +22,9 @@ LEVEL_RTOL = 0.10  # reference amplitude vs the manifest's level: 10x a controll
 UNIT_RTOL = 0.015  # a ratio this close to a unit factor is named as a units mistake (example: within 0.2 %)
 SWAP_PEAK = 2.0  # a controlled reference never peaks at twice its median amplitude over the sweep
 RESPONSE_UNIT_BAND = 1.5  # a response scale within this factor of another unit's is named as that unit
-LOW_RATIO_MAX = 0.8  # the response-units check needs the band to start below 0.8 x the resonance
-QUASI_STATIC, QUASI_STATIC_SPREAD = 0.25, 1.25  # ... and one mode's rise over the first quarter, within 1.25
 # excitation -> {unit a record or level may wrongly be in: the contract unit's size in it}
 UNIT_FACTORS = {kind: {u: 1.0 / size for u, size in UNITS[q].items() if size != 1.0} for kind, q in QUANTITY.items()}
 PLATEAU = 1.25  # a held drive's amplitude quartiles lie within this ratio (a 1 % ripple: 1.01)
-
-
-def _windows(n: int, fs: float, f0: float, f1: float, rate: float) -> tuple[NDArray[np.intp], int]:
-    """Window index of each of the first samples of the sweep (``MIN_CYCLES`` drive cycles each), and their count.
-
-    The drive's phase in cycles, ``f0 t + sign rate t^2 / 2``, is cut every ``MIN_CYCLES``
-    cycles; only whole windows within the sweep count (the last, partial one is left out).
-    """
-    sweep_s = abs(f1 - f0) / rate
-    t = np.arange(min(n, int(round(sweep_s * fs)))) / fs
-    cycles = f0 * t + 0.5 * np.sign(f1 - f0) * rate * t**2
-    k = (cycles // MIN_CYCLES).astype(np.intp)
-    whole = int((f0 * sweep_s + 0.5 * np.sign(f1 - f0) * rate * sweep_s**2) // MIN_CYCLES)
-    return k, min(whole, int(k[-1]) + 1 if k.size else 0)
-
-
-def _sums(k: NDArray[np.intp], m: int, *values: NDArray[np.float64]) -> list[NDArray[np.float64]]:
-    """Per-window sums of each array (shape (n,), n >= k.size) over the samples with index ``k < m``."""
-    use = k < m
-    return [np.bincount(k[use], weights=v[: k.size][use], minlength=m)[:m] for v in values]
 
 
 def window_amplitudes(x: NDArray[np.float64], fs: float, f0: float, f1: float, rate: float) -> NDArray[np.float64]:
@@ -65,10 +45,10 @@ def window_amplitudes(x: NDArray[np.float64], fs: float, f0: float, f1: float, r
         ``sqrt(2) * RMS`` of each mean-removed window (the amplitude of a sine), for
         the windows of at least 8 samples with more than half of them finite.
     """
-    k, m = _windows(x.size, fs, f0, f1, rate)
+    k, m = windows(x.size, fs, f0, f1, rate)
     ok = np.isfinite(x[: k.size])
     v = np.where(ok, x[: k.size], 0.0)
-    n_all, n_ok, s1, s2 = _sums(k, m, np.ones(k.size), ok.astype(float), v, v * v)
+    n_all, n_ok, s1, s2 = sums(k, m, np.ones(k.size), ok.astype(float), v, v * v)
     keep = (n_all >= 8) & (n_ok > 0.5 * n_all)
     mean = s1[keep] / n_ok[keep]
     return np.sqrt(2.0 * np.maximum(s2[keep] / n_ok[keep] - mean**2, 0.0))
@@ -111,94 +91,29 @@ def swap_problem(amp: Mapping[str, NDArray[np.float64]], kind: str, path: object
     return []
 
 
-def low_frequency_ratio(ref: NDArray[np.float64], resp: NDArray[np.float64], fs: float, f0: float, f1: float,
-                        rate: float) -> tuple[float, float, float] | None:
-    """The response/base amplitude ratio at the bottom of the band, and where the resonance is.
-
-    Parameters
-    ----------
-    ref, resp : ndarray of float, shape (n,)
-        Base and response accelerations (any one unit), from the sweep's start.
-    fs : float
-        Sample rate (Hz).
-    f0, f1, rate : float
-        The manifest's linear sweep (Hz, Hz, Hz/s).
-
-    Returns
-    -------
-    (f_low, ratio, f_peak) or None
-        The lowest window's drive frequency (Hz), |H| there, and the drive frequency
-        where |H| peaks (Hz); None when the peak lies in the band's first or last
-        window (no resonance in the band), `f_low` is above ``LOW_RATIO_MAX``
-        x `f_peak` (the band starts too close to resonance), or the ratio over the
-        first ``QUASI_STATIC`` of the way to the peak, times ``1 - (f / f_peak)^2``,
-        spreads by more than ``QUASI_STATIC_SPREAD`` (another mode down there).
-
-    Notes
-    -----
-    In each window of `window_amplitudes` (``MIN_CYCLES`` drive cycles) the response is fitted by least squares as
-    ``a x + b H[x]`` (x the base, H[x] its Hilbert transform, in quadrature with it):
-    ``|H| = hypot(a, b)`` is the transmissibility at the window's drive frequency,
-    insensitive to noise and to a free vibration at another frequency. The median of
-    the three lowest windows is the ratio. A base-driven structure follows its base
-    well below resonance: a single mode gives ``|H| ~ 1 / (1 - (f / f_peak)^2)``.
-    """
-    k, m = _windows(ref.size, fs, f0, f1, rate)
-    if m < 5:
-        return None
-    x = np.nan_to_num(ref - np.nanmedian(ref))
-    y = np.nan_to_num(resp - np.nanmedian(resp))
-    hx = _quadrature(x)
-    n, tsum, a11, a12, a22, b1, b2 = _sums(k, m, np.ones(k.size), np.arange(k.size) / fs, x * x, x * hx, hx * hx,
-                                           x * y, hx * y)
-    det = a11 * a22 - a12**2
-    with np.errstate(divide="ignore", invalid="ignore"):
-        gain = np.hypot(a22 * b1 - a12 * b2, a11 * b2 - a12 * b1) / det
-        centre = tsum / n
-    f = f0 + np.sign(f1 - f0) * rate * centre
-    ok = np.isfinite(gain) & (det > 0) & (n >= 8)
-    if ok.sum() < 5:
-        return None
-    f, gain = f[ok], gain[ok]
-    k = int(np.argmax(gain))
-    if k in (0, f.size - 1):
-        return None
-    low = np.argsort(f)[:3]
-    f_low, ratio, f_peak = float(np.median(f[low])), float(np.median(gain[low])), float(f[k])
-    if f_low > LOW_RATIO_MAX * f_peak:
-        return None
-    # the bottom quarter of the way to the peak must follow one mode's rise (no other mode down there)
-    below = (f <= f_low + QUASI_STATIC * (f_peak - f_low)) & (f < f_peak)
-    rise = gain[below] * (1.0 - (f[below] / f_peak) ** 2)
-    if below.sum() < 3 or rise.max() > QUASI_STATIC_SPREAD * rise.min():
-        return None
-    return f_low, ratio, f_peak
-
-
-def _quadrature(x: NDArray[np.float64]) -> NDArray[np.float64]:
-    """The Hilbert transform of `x` (every frequency shifted by -90 degrees), by FFT, shape of `x`."""
-    spec = np.fft.rfft(x)
-    spec[0] = 0.0
-    if x.size % 2 == 0:
-        spec[-1] = 0.0
-    return np.fft.irfft(-1j * spec, x.size)
-
-
 def level_problems(chans: Mapping[str, NDArray[np.float64]], amp: Mapping[str, NDArray[np.float64]], kind: str,
                    row: Mapping[str, Any], fs: float, path: object, run: str, drop: str,
-                   sources: Mapping[str, Mapping[str, str]]) -> list[tuple[str, str]]:
-    """(flag, sentence) for a reference amplitude off the manifest's level and, base-driven, a response in other units.
+                   sources: Mapping[str, Mapping[str, str]]) -> tuple[list[tuple[str, str]], str]:
+    """(flag, sentence) for a reference amplitude off the manifest's level and, base-driven, a response in other units;
+    and what the response-units check found, for the run's row (``response_units_check``).
 
     The median window amplitude of the reference is its level: a controller holds a
     base acceleration at it within a ripple, a generator a voltage; an open-loop force
     drops out at resonance, so for a force only a units mistake or a factor of two
     counts. For a base-driven run the response's own scale follows from
-    `low_frequency_ratio` corrected by the single-mode rise and by the base's units
+    `response_ratio` corrected by the single-mode rise and by the base's units
     mistake if any: it tells whether a base in m/s^2 came with a response in m/s^2 too,
-    and names a response in other units than declared.
+    and names a response in other units than declared. Where the record cannot tell
+    (no resonance above the band's bottom, a band starting near it, another mode there,
+    no held base level), the note says why; a force- or voltage-driven record holds
+    nothing that fixes the response's scale.
     """
+    if kind != "base":
+        note = f"not checkable: a {kind}-driven record holds nothing that fixes the response's scale"
+    else:
+        note = "undecided: the base holds no level over the sweep"
     if LEVEL[kind] not in row or min(a.size for a in amp.values()) < 3 or not _held(amp[REFERENCE[kind]]):
-        return []
+        return [], note
     ref = REFERENCE[kind]
     out: list[tuple[str, str]] = []
     level, unit = float(row[LEVEL[kind]]), LEVEL[kind].split("_", 1)[1]
@@ -206,9 +121,10 @@ def level_problems(chans: Mapping[str, NDArray[np.float64]], amp: Mapping[str, N
     ratio = got / level
     base_scale, resp_scale, low = 1.0, None, None
     if kind == "base":
-        low = low_frequency_ratio(chans[ref], chans[RESPONSE], fs, float(row["f_start_hz"]), float(row["f_stop_hz"]),
-                                  float(row["sweep_rate_hz_per_s"]))
-        resp_scale = None if low is None else low[1] * (1.0 - (low[0] / low[2]) ** 2)
+        low = response_ratio(chans[ref], chans[RESPONSE], fs, float(row["f_start_hz"]), float(row["f_stop_hz"]),
+                             float(row["sweep_rate_hz_per_s"]))
+        resp_scale = None if isinstance(low, str) else low.scale
+        note = f"undecided: {low}" if isinstance(low, str) else note
     rtol = 1.0 if kind == "force" else LEVEL_RTOL
     named = any(abs(ratio / f - 1) <= UNIT_RTOL or abs(ratio * f - 1) <= UNIT_RTOL for f in UNIT_FACTORS[kind].values())
     if not (abs(ratio - 1) <= LEVEL_RTOL or (abs(np.log(ratio)) <= np.log(1 + rtol) and not named)):
@@ -228,11 +144,20 @@ def level_problems(chans: Mapping[str, NDArray[np.float64]], amp: Mapping[str, N
                        f"{LEVEL[kind]} of run {run} in {unit} in manifest.csv {drop}.")
                 break
         out.append((f"level:{ref}", msg))
-    if resp_scale is not None:
-        scale = resp_scale * base_scale  # the response's values / its values in the declared unit
-        if not (base_scale != 1.0 and abs(np.log(scale / base_scale)) <= np.log(RESPONSE_UNIT_BAND)):
-            out += _response_units(scale, low, sources.get(RESPONSE, {}), path, drop)
-    return out
+    if isinstance(low, LowRatio):
+        scale = low.scale * base_scale  # the response's values / its values in the declared unit
+        declared = sources.get(RESPONSE, {}).get("unit", "g")
+        note = (f"{declared} confirmed: response/base {low.scale:.3g} below resonance (at {low.f_low:.0f} Hz, one "
+                f"mode's rise removed)")
+        if base_scale != 1.0 and abs(np.log(scale / base_scale)) <= np.log(RESPONSE_UNIT_BAND):
+            note = (f"flagged with the base: response/base {low.scale:.3g} below resonance (at {low.f_low:.0f} Hz), "
+                    "one unit for both")
+        else:
+            found = _response_units(scale, low, sources.get(RESPONSE, {}), path, drop)
+            out += found
+            if found:
+                note = f"flagged: response/base {low.scale:.3g} below resonance (at {low.f_low:.0f} Hz)"
+    return out, note
 
 
 def _record_units(kind: str, other: str, factor: float, unit: str, resp_scale: float | None, drop: str) -> str:
@@ -250,7 +175,7 @@ def _record_units(kind: str, other: str, factor: float, unit: str, resp_scale: f
             f"as it is {drop}.")
 
 
-def _response_units(scale: float, low: tuple[float, float, float], source: Mapping[str, str], path: object,
+def _response_units(scale: float, low: LowRatio, source: Mapping[str, str], path: object,
                     drop: str) -> list[tuple[str, str]]:
     """(flag, sentence) when a base-driven response reads `scale` times its value in the declared unit."""
     units = UNITS["acceleration"]
@@ -263,8 +188,8 @@ def _response_units(scale: float, low: tuple[float, float, float], source: Mappi
         return []
     true = found[0]
     name, by = source.get("name", RESPONSE), source.get("by", "name")
-    f_low, ratio, f_peak = low
-    sdof = 1.0 / (1.0 - (f_low / f_peak) ** 2)
+    peak = f"the peak above the band's top, {low.f_peak:.0f} Hz" if low.beyond else f"the peak at {low.f_peak:.0f} Hz"
+    rises = f"at most {low.rise:.2f}" if low.beyond else f"{low.rise:.2f}"
     if by == "name" and true in ("g", "m/s^2"):
         fix = (f"name the {source.get('noun', 'column')} {'response_accel_g' if true == 'g' else 'response_accel_m_s2'}"
                f" (it holds {true}) or export it in {declared}")
@@ -275,6 +200,6 @@ def _response_units(scale: float, low: tuple[float, float, float], source: Mappi
     else:
         fix = f"give channel {name!r} its unit in the file (it is read as {declared})"
     return [(f"units:{RESPONSE}",
-             f"{path}: below resonance (at {f_low:.0f} Hz, the peak at {f_peak:.0f} Hz) the response read from "
-             f"{name!r} as {declared} is {ratio:.3g} times the base acceleration where a base-driven structure "
-             f"follows its base ({sdof:.2f} times, rising to its resonance): is it in {true}?; {fix} {drop}.")]
+             f"{path}: below resonance (at {low.f_low:.0f} Hz, {peak}) the response read from "
+             f"{name!r} as {declared} is {low.ratio:.3g} times the base acceleration where a base-driven structure "
+             f"follows its base ({rises} times, rising to its resonance): is it in {true}?; {fix} {drop}.")]

@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 from jointcal.io._amplitudes import level_problems, swap_problem, window_amplitudes
 from jointcal.io._band import check_head, drive_band
 from jointcal.io._clipping import clip_levels, clipped_mask
+from jointcal.io._dead import dead_problem
 from jointcal.io._contract import (
     LEVEL, REFERENCE, RESPONSE, TIME, CampaignError, CampaignWarning, OnDataProblem,
     excitation_kind, excitation_of, fail,
@@ -25,10 +26,10 @@ from jointcal.io._time import check_time, time_resolution
 
 __all__ = ["validate_run", "clipped_mask", "clip_levels", "window_amplitudes", "time_resolution", "UNUSABLE_FLAGS"]
 
-# ingest flags whose run must not enter a calibration: its amplitudes or channels are wrong, or
-# it is clipped (a linear SDOF clipped at 95-60 % of its resonance peak gives damping 14-138 %
-# high even with the frames touching clipped samples left out: the peak itself is missing)
-UNUSABLE_FLAGS = ("level", "units", "swapped", "constant", "clipped")
+# ingest flags whose run must not enter a calibration: its amplitudes or channels are wrong, its response does
+# not respond to the drive (dead), or it is clipped (a linear SDOF clipped at 95-60 % of its resonance peak gives
+# damping 14-138 % high even with the frames touching clipped samples left out: the peak itself is missing)
+UNUSABLE_FLAGS = ("level", "units", "swapped", "constant", "clipped", "dead")
 
 
 def _count(k: int, noun: str) -> str:
@@ -54,7 +55,8 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
     on_data_problem : {'error', 'flag'}, optional
         What to do with data problems (NaN/inf values, a constant channel, clipping,
         swapped channels, a reference amplitude off the manifest's level, a base-driven
-        response in other units than declared): raise, or
+        response in other units than declared, a response that does not respond to the
+        drive): raise, or
         record them in ``flags`` and emit a `CampaignWarning` with the same sentence.
         Structural problems always raise.
 
@@ -69,9 +71,12 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
         (which a free-decay tail may follow), each referred to that instant with the
         manifest's sweep rate (Hz); ``f_tolerance_hz``, the allowed deviation from
         ``f_start_hz``/``f_stop_hz`` (Hz) (the three NaN when the reference holds no
-        signal); ``flags``, a list such as ``['nonfinite:response_accel_g',
+        signal); ``response_units_check``, what the base-driven response-units check
+        found, in words: '<unit> confirmed: ...', 'flagged: ...', 'undecided: <why>' or
+        'not checkable: ...' (force- and voltage-driven); ``flags``, a list such as ``['nonfinite:response_accel_g',
         'clipped:base_accel_g']``; the words are ``nonfinite``, ``constant``,
-        ``clipped``, ``swapped``, ``level`` and ``units`` (see `UNUSABLE_FLAGS`).
+        ``clipped``, ``swapped``, ``level``, ``units`` and ``dead`` (a response that
+        does not follow the drive, `jointcal.io._dead`) (see `UNUSABLE_FLAGS`).
 
     Raises
     ------
@@ -138,13 +143,20 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
                  f"correct direction, f_start_hz, f_stop_hz or sweep_rate_hz_per_s of run {run}"
                  + (f" (the record's data problems first: {', '.join(flags)})" if flags else ""))
     if not silent and not swapped:
-        _report(level_problems(chans, amp, kind, row, fs, path, run, drop, df.attrs.get("sources", {})), flags,
-                on_data_problem)
+        _report(dead_problem(chans[ref], chans[RESPONSE], fs, f0, f1, rate, path, drop,
+                             df.attrs.get("sources", {}).get(RESPONSE, {})), flags, on_data_problem)
+    units_note = "undecided: the channels are silent or swapped"
+    if not silent and not swapped and not any(f.startswith("dead:") for f in flags):
+        problems, units_note = level_problems(chans, amp, kind, row, fs, path, run, drop, df.attrs.get("sources", {}))
+        _report(problems, flags, on_data_problem)
+    elif any(f.startswith("dead:") for f in flags):
+        units_note = "undecided: the response does not respond to the drive"
     rms = {f"rms_{c}": float("nan") for c in (*REFERENCE.values(), RESPONSE)}
     rms.update({f"rms_{c}": float(np.sqrt(np.mean(x[np.isfinite(x)] ** 2))) for c, x in chans.items()
                 if np.isfinite(x).any()})
     return {"n_samples": t.size, "duration_s": t.size / fs, "fs_measured_hz": fs, "excitation": kind, **rms,
-            "f_first_hz": f_first, "f_last_hz": f_last, "f_tolerance_hz": tol, "flags": flags}
+            "f_first_hz": f_first, "f_last_hz": f_last, "f_tolerance_hz": tol, "response_units_check": units_note,
+            "flags": flags}
 
 
 def _data_problems(t: NDArray[np.float64], chans: dict[str, NDArray[np.float64]], clip_run: int,

@@ -8,7 +8,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from typing import Literal, NoReturn
 
-from jointcal.units import FOOT_IN, G, G_SI, LBF_N
+from jointcal.units import FOOT_IN, G, G_SI, INCH_M, LBF_N
 
 __all__: list[str] = []
 
@@ -35,7 +35,13 @@ UNITS: dict[str, dict[str, float]] = {
     "force": {"lbf": 1.0, "N": 1.0 / LBF_N, "kN": 1e3 / LBF_N},
     "voltage": {"V": 1.0, "mV": 1e-3},
     "time": {"s": 1.0, "ms": 1e-3},
+    # read so that a channel of these quantities is named as such (a laser vibrometer), never used as a role
+    "velocity": {"m/s": 1.0, "mm/s": 1e-3, "in/s": INCH_M},
+    "displacement": {"m": 1.0, "mm": 1e-3, "in": INCH_M},
 }
+# the SI unit of each quantity, in which Test.Lab stores its values (MKS) and UFF 58 converts with data set 164
+SI_UNIT: dict[str, str] = {"acceleration": "m/s^2", "force": "N", "voltage": "V", "time": "s", "velocity": "m/s",
+                           "displacement": "m"}
 FS_RTOL = 1e-3  # allowed relative sample-rate disagreement with the manifest
 MIN_CYCLES = 20  # cycles of the lowest drive frequency in each frequency window
 

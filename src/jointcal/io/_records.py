@@ -156,7 +156,10 @@ def _read_mat(path: Path, kind: Excitation | None, channels: dict[str, str | Non
         mat = scipy.io.loadmat(path)
     except NotImplementedError:
         fail(path, "it is a MATLAB v7.3 (HDF5) file", "save it with save(..., '-v7')")
-    except (OSError, ValueError, TypeError) as exc:
+    except OSError as exc:  # scipy.io: 'could not read bytes', the file ends inside a variable
+        fail(path, f"it ends before its data do ({exc}): the file is cut short",
+             "export the run again (or copy the whole file)")
+    except (ValueError, TypeError) as exc:
         fail(path, f"cannot be read as a MATLAB file ({exc})", "save it with MATLAB's save(..., '-v7')")
     names = [k for k in mat if not k.startswith("__")]
     if is_testlab(mat):

@@ -62,6 +62,8 @@ FLAG_WORDS = {
     "units": "the response/base ratio below resonance says the response is in other units than its column "
              "name (ingest's check); the run is left out",
     "no_mode": "the run's band holds none of the modes found in its assembly's runs (jointcal.measure.modes)",
+    "dead": "the response does not respond to the drive (an offset and noise: a dead or unplugged sensor; "
+            "ingest's check); the run is left out",
     "unusable": "no resonance could be estimated from this run",
 }
 
