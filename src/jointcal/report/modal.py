@@ -73,11 +73,14 @@ def plot_envelopes(table: pd.DataFrame, envs: dict[str, pd.DataFrame], path, ram
 
 
 def plot_frequency_damping(table: pd.DataFrame, path) -> None:
-    """Fig. 3.6: resonance frequency and damping versus amplitude, both damping estimators."""
+    """Fig. 3.6: resonance frequency and damping versus amplitude, both damping estimators (a series per
+    assembly, or per assembly and mode where an assembly holds several)."""
     plt = _plt()
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
-    for i, (asm, g) in enumerate(table.groupby("assembly", sort=False)):
-        c = f"C{i}"
+    keys = ["assembly", "mode"] if "mode" in table.columns and table["mode"].nunique() > table["assembly"].nunique() \
+        else ["assembly"]  # one series per assembly, or per assembly and mode where one has several
+    for i, (key, g) in enumerate(table.groupby(keys, sort=False)):
+        asm, c = " ".join(map(str, key)), f"C{i}"
         bad = g["flags"].fillna("").str.contains("unusable")
         g = g[~bad]
         a1.semilogx(g["q_in"], g["f_res_hz"], "o", color=c, label=f"{asm}")
