@@ -93,69 +93,21 @@ def campaign_index(manifest: str | os.PathLike[str]) -> CampaignIndex:
                          problem=problem)
 
 
-def _with_modes(t):
-    """A modal table with its ``mode`` column; a table without one (made before modes were tracked, or by
-    hand) holds one mode per assembly, named by its frequency at the assembly's lowest level."""
-    import numpy as np
-
-    from jointcal.io import level_column
-    from jointcal.measure.modes import mode_name
-
-    if "mode" in t.columns:
-        return t.assign(mode=t["mode"].fillna("").astype(str))
-    level = level_column(t.columns)
-    names = {}
-    for asm, g in t.groupby("assembly", sort=False):
-        ok = g[np.isfinite(g["f_res_hz"].astype(float))] if "f_res_hz" in g else g.iloc[:0]
-        low = ok.sort_values(level, kind="stable") if level and len(ok) else ok
-        names[asm] = mode_name(float(low["f_res_hz"].iloc[0])) if len(low) else "m0"
-    return t.assign(mode=t["assembly"].map(names))
-
-
 def unit_table(modal, assembly: str, mode: str):
-    """The rows of one (assembly, mode) of a modal table (a DataFrame read with text ``assembly``)."""
-    t = _with_modes(modal)
+    """The rows of one (assembly, mode) of a modal table (`jointcal.measure.modes.with_modes`)."""
+    from jointcal.measure.modes import with_modes
+
+    t = with_modes(modal)
     return t[(t["assembly"].astype(str) == assembly) & (t["mode"] == mode)]
 
 
 def modal_units(modal_csv: str | os.PathLike[str]) -> list[tuple[str, str]]:
-    """The (assembly, mode) pairs calibrated: each mode read in usable runs at two levels or more.
-
-    An assembly none of whose modes has two levels keeps its mode read in the most usable runs (or,
-    with none usable, its first), so that its calibration stops with the sentence that names the cause.
-
-    Parameters
-    ----------
-    modal_csv : path-like
-        The modal stage's ``modal_properties.csv`` (columns ``assembly``, ``mode``, ``flags``, ``f_res_hz``
-        and a level column, `jointcal.io.level_column`; without ``mode``, one mode per assembly).
-
-    Returns
-    -------
-    list of (str, str)
-        In the order of the assemblies' first rows, modes by ascending frequency.
-    """
-    import numpy as np
+    """The (assembly, mode) pairs calibrated, from the modal stage's table (`jointcal.measure.modes.units`)."""
     import pandas as pd
 
-    from jointcal.io import level_column
+    from jointcal.measure.modes import units
 
-    t = _with_modes(pd.read_csv(modal_csv, dtype={"assembly": str, "mode": str, "flags": str}))
-    t = t[t["mode"] != ""]
-    level = level_column(t.columns)
-    f = pd.to_numeric(t.get("f_res_hz", pd.Series(np.nan, index=t.index)), errors="coerce")
-    usable = t[~t["flags"].fillna("").str.contains("unusable") & np.isfinite(f)]
-    out = []
-    for asm, g in t.groupby("assembly", sort=False):
-        u = usable[usable["assembly"] == asm]
-        order = f[g.index].groupby(g["mode"], sort=False).median().sort_values(na_position="last").index
-        n_levels = u.groupby("mode")[level].nunique() if level and len(u) else pd.Series(dtype=int)
-        kept = [m for m in order if n_levels.get(m, 0) >= 2]
-        if not kept:
-            counts = u["mode"].value_counts()
-            kept = [counts.index[0] if len(counts) else order[0]]
-        out += [(str(asm), str(m)) for m in kept]
-    return out
+    return units(pd.read_csv(modal_csv, dtype={"assembly": str, "mode": str, "flags": str}))
 
 
 def unit_of(path: str | os.PathLike[str]) -> tuple[str, str]:

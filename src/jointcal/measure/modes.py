@@ -33,7 +33,8 @@ import pandas as pd
 from numpy.typing import NDArray
 from scipy import signal
 
-__all__ = ["modal_peaks", "track_modes", "mode_name", "PROMINENCE", "GAP", "PHASE_TURN_DEG", "COHERENCE"]
+__all__ = ["modal_peaks", "track_modes", "mode_name", "with_modes", "units", "PROMINENCE", "GAP", "PHASE_TURN_DEG",
+           "COHERENCE"]
 
 PROMINENCE = 10.0  # a mode stands this many times over the troughs that bound it (20 dB)
 COHERENCE = 0.5  # the drive's share of the response at the peak at least the noise's
@@ -155,3 +156,57 @@ def track_modes(peaks: Mapping[str, Sequence[float]], bands: Mapping[str, tuple[
             if r in found or min(lo, hi) < median < max(lo, hi):
                 rows.append(dict(run_id=r, mode=name, f_guess_hz=found.get(r, median), detected=r in found))
     return pd.DataFrame(rows, columns=["run_id", "mode", "f_guess_hz", "detected"])
+
+
+def with_modes(table: pd.DataFrame) -> pd.DataFrame:
+    """A modal table with its ``mode`` column (text, empty for a run read at none); a table without one
+    (made before modes were tracked, or by hand) holds one mode per assembly, named by its resonance at
+    the assembly's lowest level."""
+    from ..io import level_column
+
+    if "mode" in table.columns:
+        return table.assign(mode=table["mode"].fillna("").astype(str))
+    level = level_column(table.columns)
+    f = pd.to_numeric(table.get("f_res_hz", pd.Series(np.nan, index=table.index)), errors="coerce")
+    names = {}
+    for asm, g in table[np.isfinite(f)].groupby("assembly", sort=False):
+        low = g.sort_values(level, kind="stable") if level else g
+        names[asm] = mode_name(float(low["f_res_hz"].iloc[0]))
+    return table.assign(mode=table["assembly"].map(names).fillna("m0"))
+
+
+def units(table: pd.DataFrame) -> list[tuple[str, str]]:
+    """The (assembly, mode) pairs calibrated: each mode read in usable runs at two levels or more.
+
+    An assembly none of whose modes has two levels keeps its mode read in the most usable runs (or,
+    with none usable, its first), so that its calibration stops with the sentence that names the cause.
+
+    Parameters
+    ----------
+    table : DataFrame
+        ``modal_properties.csv`` (``assembly``, ``mode``, ``flags``, ``f_res_hz`` and a level column,
+        `jointcal.io.level_column`; without ``mode``, one mode per assembly: `with_modes`).
+
+    Returns
+    -------
+    list of (str, str)
+        In the order of the assemblies' first rows, modes by ascending frequency.
+    """
+    from ..io import level_column
+
+    t = with_modes(table)
+    t = t[t["mode"] != ""]
+    level = level_column(t.columns)
+    f = pd.to_numeric(t.get("f_res_hz", pd.Series(np.nan, index=t.index)), errors="coerce")
+    usable = t[~t["flags"].fillna("").astype(str).str.contains("unusable") & np.isfinite(f)]
+    out = []
+    for asm, g in t.groupby("assembly", sort=False):
+        u = usable[usable["assembly"] == asm]
+        order = f[g.index].groupby(g["mode"], sort=False).median().sort_values(na_position="last").index
+        n_levels = u.groupby("mode")[level].nunique() if level and len(u) else pd.Series(dtype=int)
+        kept = [m for m in order if n_levels.get(m, 0) >= 2]
+        if not kept:
+            counts = u["mode"].value_counts()
+            kept = [counts.index[0] if len(counts) else order[0]]
+        out += [(str(asm), str(m)) for m in kept]
+    return out
