@@ -66,6 +66,6 @@ def test_e_of_a_biased_model_grows_with_the_own_noise_scale():
 
 def test_own_noise_needs_frames():
     rng = np.random.default_rng(6)
-    fr = _frames(rng, 0.1, 0.5, n=8)
-    sigma, dof = own_noise({"a": fr}, _metrics(["a"], [1.0], ["up"]).assign(n_frames=8))
+    fr = _frames(rng, 0.1, 0.5, n=12)
+    sigma, dof = own_noise({"a": fr}, _metrics(["a"], [1.0], ["up"]).assign(n_frames=12))  # < 10 a bin and side
     assert (dof == 0).all() and np.isnan(sigma).all()

@@ -39,16 +39,16 @@ from ..calibrate.settings import CalibrateSettings
 from ..io import write_bytes_atomic, write_csv_atomic
 from .likelihood import LogPosterior
 from .modes import find_modes, mode_labels, modes_text
-from .noise import data_problem, noise_scale, scale_words
+from .fit import P_REJECT, fit_test, goodness_of_fit
+from .noise import data_problem, noise_scale
 from .sampler import ChainResult, random_state_arrays, random_state_tuple, run_chain
 from .settings import PosteriorSettings
 from .summary import burn_in, constraints_text, predictive_band, summarize
 
-__all__ = ["OUTPUTS", "OBSERVED", "P_REJECT", "start_ball", "run_posterior", "goodness_of_fit",
+__all__ = ["OUTPUTS", "OBSERVED", "P_REJECT", "start_ball", "run_posterior", "posterior_of", "goodness_of_fit",
            "fit_test"]
 
 OUTPUTS = ("summary.csv", "chain.npz", "constraints.txt", "predictive.csv")
-P_REJECT = 1e-3  # chi-square probability below which the data reject the model
 OBSERVED = ("Fs", "KT", "beta", "k")  # parameters whose own tau also counts in the stopping rule (y mixes them)
 
 
@@ -65,56 +65,6 @@ def start_ball(lp: LogPosterior, theta: np.ndarray, ps: PosteriorSettings) -> np
     x0 = x + ps.ball * width * rng.standard_normal((ps.n_walkers, lp.ndim))
     x0 = np.clip(x0, lp.lower + 1e-9 * width, lp.upper - 1e-9 * width)
     return lp.to_y(x0)
-
-
-def goodness_of_fit(lp: LogPosterior, theta: np.ndarray, p_reject: float = P_REJECT,
-                    sources: tuple[str, str] = ("repeats", "repeats")) -> tuple[list[float], str]:
-    """How far the GA optimum misses the data, against the noise scales (the repeat scatter, or the read-outs'
-    own scatter where the campaign has no repeats: `jointcal.posterior.noise`).
-
-    Parameters
-    ----------
-    lp : LogPosterior
-        Data and noise floors (``lp.data.rel_noise``: relative scatter of f and zeta).
-    theta : ndarray, shape (n,)
-        The optimum in `lp.space` (Fs lbf, KT lbf/in, chi, beta, k lbf/in, zeta_v, and any grown parameter).
-    p_reject : float
-        Chi-square probability below which the sentence says the data reject the model.
-    sources : (str, str)
-        Where the frequency's and the damping's scales came from (`jointcal.posterior.noise.SOURCE_WORDS`).
-
-    Returns
-    -------
-    ratios : list of float
-        rms relative residual of f and of zeta divided by its noise scale.
-    sentence : str
-    """
-    x = lp.space.to_unit(theta) * (lp.space.x_hi - lp.space.x_lo) + lp.space.x_lo
-    r_f, r_z = lp.residuals(x[None])
-    s_f, s_z = lp.data.rel_noise
-    rms = [float(np.sqrt(np.mean(r_f**2))), float(np.sqrt(np.mean(r_z**2)))]
-    ratios = [rms[0] / s_f, rms[1] / s_z]
-    test = fit_test(lp, theta)
-    stat, dof, p = test["fit_chi2"], int(test["fit_dof"]), test["fit_p"]
-    scale = scale_words(sources)
-    verdict = (f"the data reject the model at the precision of {scale} (model error, not noise, sets the "
-               "noise scales, which widen the intervals)" if p < p_reject else f"consistent with {scale}")
-    return ratios, (f"Fit of the GA optimum: rms relative residuals {rms[0]:.2g} (frequency) and {rms[1]:.2g} "
-                    f"(damping) = {ratios[0]:.1f} and {ratios[1]:.1f} x {scale}; chi-square {stat:.0f} "
-                    f"for {dof} degrees of freedom (p = {p:.1g}): {verdict}.")
-
-
-
-def fit_test(lp: LogPosterior, theta: np.ndarray) -> dict[str, float]:
-    """The chi-square test of `goodness_of_fit` as numbers: fit_chi2, fit_dof, fit_p (stored in chain.npz)."""
-    from scipy.stats import chi2
-
-    x = lp.space.to_unit(theta) * (lp.space.x_hi - lp.space.x_lo) + lp.space.x_lo
-    r_f, r_z = lp.residuals(x[None])
-    s_f, s_z = lp.data.rel_noise
-    stat = float(np.sum((r_f / s_f) ** 2) + np.sum((r_z / s_z) ** 2))
-    dof = max(2 * r_f.size - len(theta), 1)
-    return {"fit_chi2": stat, "fit_dof": float(dof), "fit_p": float(chi2.sf(stat, dof))}
 
 
 def _npz(arrays: dict) -> bytes:
@@ -137,6 +87,28 @@ def _read(modal_csv, scatter_csv, ga_best_json, assembly: str, cal: CalibrateSet
             raise CalibrationInputError(f"{ga_best_json}: it was calibrated with {key} {best.get(key)!r}, "
                                         f"the config now says {getattr(cal, key)!r}; rerun the calibrate stage.")
     return data, best, cal, cal.space.vector(best), [*data.notes, *own], sources
+
+
+def posterior_of(modal_csv, scatter_csv, ga_best_json, assembly: str, cal: CalibrateSettings, ps: PosteriorSettings
+                 ) -> tuple[LogPosterior, dict, CalibrateSettings, np.ndarray, list[str], tuple[str, str]]:
+    """The log-posterior the chain samples, without sampling: read (`_read`), stop on what in the data makes it
+    meaningless (`data_problem`: two modes, noise above noise_max), and build it. `fit_test` of it at the
+    returned optimum is the chi-square the verdict shows.
+
+    Returns
+    -------
+    lp, best, cal, theta, notes, sources
+        The LogPosterior, ga_best.json, the resolved settings, the optimum, notes for the log and the
+        noise scales' sources.
+    """
+    data, best, cal, theta, notes, sources = _read(modal_csv, scatter_csv, ga_best_json, assembly, cal, ps)
+    noise_max = (ps.noise_max["frequency"], ps.noise_max["damping"])
+    problems = data_problem(data, noise_max=noise_max, where=str(modal_csv))
+    stop = [text for kind, text in problems if kind in ("two_modes", "noise")]
+    if stop:  # the sentence names the cause in the data and the fix
+        raise CalibrationInputError(stop[0])
+    lp = LogPosterior(data, cal.space, cal.m, cal.model, cal.viscous, noise_max)
+    return lp, best, cal, theta, notes + [text for _, text in problems], sources
 
 
 def _fingerprint(data: ModalData, theta: np.ndarray, cal: CalibrateSettings, ps: PosteriorSettings) -> str:
@@ -243,14 +215,8 @@ def run_posterior(modal_csv: str | os.PathLike[str], scatter_csv: str | os.PathL
     notes : list of str
         Lines for the log (floors used, resume, convergence).
     """
-    data, best, cal, theta, notes, sources = _read(modal_csv, scatter_csv, ga_best_json, assembly, cal, ps)
-    noise_max = (ps.noise_max["frequency"], ps.noise_max["damping"])
-    problems = data_problem(data, noise_max=noise_max, where=str(modal_csv))
-    stop = [text for kind, text in problems if kind in ("two_modes", "noise")]
-    if stop:  # the sentence names the cause in the data and the fix
-        raise CalibrationInputError(stop[0])
-    notes += [text for _, text in problems]
-    lp = LogPosterior(data, cal.space, cal.m, cal.model, cal.viscous, noise_max)
+    lp, best, cal, theta, notes, sources = posterior_of(modal_csv, scatter_csv, ga_best_json, assembly, cal, ps)
+    data = lp.data
     fingerprint = _fingerprint(data, theta, cal, ps)
     ckpt = None if checkpoint is None else Path(checkpoint)
     res = _sample(lp, theta, ps, fingerprint, _resume(ckpt, fingerprint, notes), ckpt, progress)

@@ -201,7 +201,8 @@ def _not_applicable(next_test: Mapping, identified: pd.DataFrame | None) -> str:
     pm = next_test.get("phi_max_interval_in") or [np.nan, np.nan]
     q_max = float(next_test.get("largest_amplitude_in", np.nan))
     if why:
-        return text + " Settle the posterior first (item 3): " + html.escape(why.split(": ", 1)[-1])
+        return (text + " Settle the posterior first (item 3 says what to run): until then no amplitude can be "
+                "chosen to identify a parameter.")
     if not free:
         return text + " The data identify every parameter of the joint; no further level is needed for that."
     if np.isfinite(q_max) and np.isfinite(pm[1]) and q_max > pm[1]:

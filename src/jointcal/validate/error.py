@@ -99,7 +99,7 @@ def repeat_scatter(frames: Mapping[str, pd.DataFrame], metrics: pd.DataFrame, *,
 
 
 def own_noise(frames: Mapping[str, pd.DataFrame], metrics: pd.DataFrame, *, degree: int = 2,
-              min_frames: int = 6, chunk: int = 24) -> tuple[np.ndarray, np.ndarray]:
+              min_frames: int = 10, chunk: int = 24) -> tuple[np.ndarray, np.ndarray]:
     """Each bin's noise of the measured magnitude (dB) and phase (deg), from the runs themselves.
 
     Within every run, the in-band frames of one bin on one side of the measured resonance
@@ -217,8 +217,8 @@ def _pct(x: float) -> str:
 
 _SCALE = {"repeats": ("the repeat-to-repeat scatter", "a repeated test", "the repeat scatter"),
           "own noise": ("each run's own noise (no repeated runs)", "the runs' own noise", "the runs' own noise"),
-          "floor": ("the noise floor (validate.floor_db, floor_deg: no repeats, too few frames for the runs' own "
-                    "noise)", "the noise floor", "the noise floor")}
+          "floor": ("the noise floor validate.floor_db and floor_deg, for want of repeats or of frames enough for "
+                    "the runs' own noise", "the noise floor", "the noise floor")}
 
 
 def scale_source(scale: object) -> str:
@@ -237,7 +237,7 @@ def closeness(E: float, source: str = "repeats") -> str:
     """How close a model's envelopes are to the measured ones, in words, from E (1 = the scale of ``source``)."""
     _, test, scatter = _SCALE.get(source, _SCALE["repeats"])
     return (f"about as close as {test}" if E <= 2 and source == "repeats" else
-            f"within about twice {scatter}" if E <= 2 else
+            f"within {scatter}" if E <= 1 else f"within about twice {scatter}" if E <= 2 else
             f"clearly outside {scatter}" if E > 5 else f"somewhat outside {scatter}")
 
 
