@@ -6,6 +6,8 @@ past macroslip that identify every parameter when the chain has settled (tests/t
 """
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -58,10 +60,13 @@ def test_without_repeats_the_noise_scale_is_the_read_outs_own_not_the_floor():
 
 
 def test_two_modes_in_one_assembly_name_the_runs_and_the_config_fix():
-    """The held-out beam: 70-110 Hz runs read at the 95 Hz mode, 0.5-110 Hz runs at 18.6 Hz, same levels."""
-    q = np.repeat([0.1, 0.2, 0.3, 0.4], 2)
-    f = np.tile([95.0, 18.6], 4) * (1 - 0.01 * q)
-    data = _data(q, f, np.full(8, 0.02), runs=[f"{r}_{v}" for v in range(4) for r in ("slow", "fast")])
+    """The held-out beam: 70-110 Hz runs read at the 95 Hz mode, 0.5-110 Hz runs at 18.6 Hz, same levels; the
+    18.6 Hz mode's displacement is (95/18.6)^2 = 26x larger, so their amplitudes do not overlap."""
+    level = np.repeat([0.05, 0.1, 0.2, 0.3], 2)
+    q = level * np.tile([1.0, 26.0], 4)
+    f = np.tile([95.0, 18.6], 4) * (1 - 0.01 * level)
+    data = replace(_data(q, f, np.full(8, 0.02), runs=[f"{r}_{v}" for v in range(4) for r in ("slow", "fast")]),
+                   level=level)
     text = dict(data_problem(data, noise=(0.9, 0.7), noise_max=(0.05, 0.5)))
     assert "two_modes" in text and "noise" in text
     assert "mode_hz: 94" in text["two_modes"] and "slow_0" in text["two_modes"] and "fast_0" in text["two_modes"]

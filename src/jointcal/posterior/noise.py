@@ -119,9 +119,10 @@ def noise_scale(data: ModalData, scatter: pd.DataFrame | None,
     return replace(data, rel_noise=(float(noise[0]), float(noise[1]))), (sources[0], sources[1]), notes
 
 
-def _clusters(f: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
-    """Two groups of resonances far apart (a gap of more than 20% and 10x either group's spread) whose
-    amplitudes overlap (a softening joint orders them by amplitude instead), else None."""
+def _clusters(f: np.ndarray, q: np.ndarray, level: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """Two groups of resonances far apart (a gap of more than 20% and 10x either group's spread), each of two
+    runs or more, that share a drive level or overlap in amplitude (a softening joint orders its runs by
+    level and amplitude instead), else None."""
     o = np.argsort(f)
     lf = np.log(f[o])
     if lf.size < 4:
@@ -130,7 +131,8 @@ def _clusters(f: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray] | N
     k = int(np.argmax(gaps))
     lo, hi = o[: k + 1], o[k + 1:]
     spread = max(float(np.ptp(lf[: k + 1])), float(np.ptp(lf[k + 1:])), 1e-6)
-    overlap = q[hi].max() > q[lo].min()  # the higher group reaches amplitudes the lower one also has
+    same_level = bool(np.intersect1d(np.round(level[lo], 9), np.round(level[hi], 9)).size)
+    overlap = same_level or q[hi].max() > q[lo].min()  # a level read at both, or amplitudes both reach
     if gaps[k] > np.log(1.2) and gaps[k] > 10 * spread and overlap and min(lo.size, hi.size) >= 2:
         return lo, hi
     return None
@@ -142,7 +144,7 @@ def data_problem(data: ModalData, *, noise: tuple[float, float] | None = None,
     """What in the read-outs stops or weakens the posterior: (kind, one sentence with the fix) each.
 
     Kinds, in this order: 'two_modes' (the runs' f_res cluster at two frequencies more than
-    20% apart over the same amplitudes: two modes mixed in one assembly), 'noise' (noise
+    20% apart at the same levels or amplitudes: two modes mixed in one assembly), 'noise' (noise
     scales at or above ``noise_max``, the posterior's stop), 'few_levels' (fewer than 3
     distinct amplitudes for a 6-parameter joint) and 'flat' (f and zeta change over the
     levels by less than twice their noise).
@@ -150,13 +152,13 @@ def data_problem(data: ModalData, *, noise: tuple[float, float] | None = None,
     a, f = data.assembly, np.asarray(data.f, dtype=float)
     q = np.asarray(data.q, dtype=float)
     out = []
-    two = _clusters(f, q)
+    two = _clusters(f, q, np.asarray(data.level, dtype=float))
     if two is not None:
         lo, hi = (np.asarray(data.run_id)[g] for g in two)
         f_lo, f_hi = (float(np.median(f[g])) for g in two)
         out.append(("two_modes", f"{where}: the runs of assembly {a!r} read two different modes, f_res near "
                     f"{f_lo:.4g} Hz ({', '.join(lo[:4])}{', ...' if len(lo) > 4 else ''}) and near {f_hi:.4g} Hz "
-                    f"({', '.join(hi[:4])}{', ...' if len(hi) > 4 else ''}) over the same amplitudes, and one joint "
+                    f"({', '.join(hi[:4])}{', ...' if len(hi) > 4 else ''}) at the same levels or amplitudes, and one joint "
                     f"cannot fit both; read one mode in every run with `modal: {{mode_hz: {f_hi:.3g}}}` (or "
                     f"{f_lo:.3g}) in a config file given by --configfile, then rerun from the modal stage."))
     s = noise if noise is not None else data.rel_noise
