@@ -81,39 +81,37 @@ def first_answer(validation: Mapping | None, fit: Mapping | None) -> bool | None
 def _item1(best: Mapping, validation: Mapping | None, fit: Mapping | None) -> str:
     kind = "the paper's model" if best.get("model_kind", "ministack") == "ministack" else "the calibrated mode"
     answer = first_answer(validation, fit)
-    e_part = chi_part = ""
-    if validation is not None:
-        E, src = float(validation["E"]), scale_source(validation.get("scale"))
-        e_part = (f"its envelopes give E = <b>{E:.2f}</b> (1 = {scale_words(src)}): {closeness(E, src)}")
-    has_fit = fit is not None and np.isfinite(fit.get("fit_p", np.nan))
-    if has_fit:
-        p = float(fit["fit_p"])  # type: ignore[index]
-        src2 = tuple(str(v) for v in fit.get("noise_source", ("repeats", "repeats")))  # type: ignore[union-attr]
-        reject = p < P_REJECT
-        chi_part = (f"its calibrated frequencies and damping ratios {'are rejected by' if reject else 'agree with'} "
-                    f"{noise_words(src2)}: chi-square {_g(float(fit['fit_chi2']))} for "  # type: ignore[index]
-                    f"{int(fit['fit_dof'])} degrees of freedom, p = {p:.1g}"  # type: ignore[index]
-                    f"{' (the model, not noise, sets the misfit)' if reject else ''}")
     if answer is None:
         return "The validation stage did not run, and the posterior has no chi-square test."
-    head = f"{'<b>Yes</b>' if answer else '<b>No</b>'}: {kind} against the measurements"
-    parts = [p for p in (e_part, chi_part) if p]
-    if answer or len(parts) == 1:
-        text = f"{head}: " + "; and ".join(parts) + "."
-    else:  # No, with two tests: the failing one first, then the other in its own light
-        e_fails = float(validation["E"]) > HOLDS_E  # type: ignore[index]
-        chi_fails = float(fit["fit_p"]) < P_REJECT  # type: ignore[index]
-        if e_fails and chi_fails:
-            text = f"{head}: {e_part}; and {chi_part}."
-        elif chi_fails:
-            text = (f"{head}: {chi_part}. The envelopes alone do not resolve this misfit: {e_part}, a coarser "
-                    "test than the read-outs' own precision.")
-        else:
-            text = (f"{head}: {e_part}. Its frequencies and damping alone pass: {chi_part}; the misfit is in the "
-                    "envelopes' shape, not the backbone.")
+    word = "<b>Yes</b>" if answer else "<b>No</b>"
+    e_text = chi_text = ""
+    e_ok = chi_ok = None
+    if validation is not None:
+        E, src = float(validation["E"]), scale_source(validation.get("scale"))
+        e_ok = E <= HOLDS_E
+        e_text = f"E = <b>{E:.2f}</b> (1 = {scale_words(src)}): {closeness(E, src)}"
+    if fit is not None and np.isfinite(fit.get("fit_p", np.nan)):
+        p = float(fit["fit_p"])
+        sources = tuple(str(v) for v in fit.get("noise_source", ("repeats", "repeats")))
+        chi_ok = p >= P_REJECT
+        chi_text = (f"{'agree with' if chi_ok else 'are rejected by'} "
+                    f"{'the repeats' if sources == ('repeats', 'repeats') else noise_words(sources)}: chi-square "
+                    f"{_g(float(fit['fit_chi2']))} for {int(fit['fit_dof'])} degrees of freedom, p = {p:.1g}"
+                    f"{'' if chi_ok else ' (the model, not noise, sets the misfit)'}")
+    if e_ok is False or e_ok is None and chi_ok is False or e_ok and chi_ok is not False:
+        # the first test shown carries the answer (E, else the chi-square), the other agrees or adds to it
+        parts = [f"{word}: {kind} against the measured envelopes, {e_text}." if e_text else
+                 f"{word}: {kind}'s frequencies and damping ratios {chi_text}."]
+        if e_text and chi_text:
+            parts.append(f"Its calibrated frequencies and damping ratios {chi_text}"
+                         + ("; the misfit lies in the envelopes, not in the backbone's frequencies and damping."
+                            if chi_ok and not e_ok else "."))
+    else:  # E within its scale, the chi-square rejecting: No, for the chi-square's reason
+        parts = [f"{word}: {kind}'s frequencies and damping ratios {chi_text}.",
+                 f"The envelopes alone do not show this misfit: {e_text}."]
     if validation is None:
-        text += " (The validation stage did not run.)"
-    return text
+        parts.append("(The validation stage did not run.)")
+    return " ".join(parts)
 
 
 def _item2(diagnosis: Mapping | None, best: Mapping) -> str:
