@@ -120,3 +120,31 @@ def test_an_unconverged_or_multimodal_chain_identifies_no_parameter_and_says_wha
     assert settled_table(raw.drop(columns="why_not")).equals(raw.drop(columns="why_not"))
     why = unsettled(_chain(modes=True), names)
     assert "2 separated modes" in why and "mode 2 (33% of the draws): Fs" in why
+
+
+@pytest.mark.slow  # a GA run
+def test_the_posterior_stage_stops_on_two_modes_with_the_fix_not_the_noise_floors(tmp_path):
+    """The held-out beam's stop, on files: 'noise floors [0.94 0.68] must be finite and below noise_max' became
+    one sentence naming the two modes, their runs and `modal: {mode_hz: ...}`."""
+    from jointcal.calibrate import CalibrationInputError, run_calibration
+    from jointcal.io import write_csv_atomic
+    from jointcal.measure.scatter import scatter
+    from jointcal.posterior import PosteriorSettings
+    from jointcal.posterior.stage import posterior_of
+
+    level = np.repeat([0.05, 0.1, 0.15, 0.2, 0.25, 0.3], 2)
+    slow = np.tile([True, False], 6)  # 70-110 Hz at 5 Hz/s (the 95 Hz mode), 0.5-110 Hz at 13.75 Hz/s (18.6 Hz)
+    f = np.where(slow, 95.0 * (1 - 0.16 * level), 18.6 * (1 - 0.05 * level))
+    table = pd.DataFrame(dict(run_id=[f"{'slow' if s else 'fast'}_{v:g}V" for s, v in zip(slow, level)],
+                              assembly="beam", level_V=level, direction="up", q_in=level * np.where(slow, 1.0, 26.0),
+                              f_res_hz=f, zeta_res=np.where(slow, 0.018, 0.006) * (1 + level), flags=""))
+    write_csv_atomic(table, tmp_path / "modal_properties.csv")
+    write_csv_atomic(scatter(table), tmp_path / "scatter.csv")
+    cal = CalibrateSettings()
+    run_calibration(tmp_path / "modal_properties.csv", "beam", tmp_path / "cal", cal)
+    with pytest.raises(CalibrationInputError) as err:
+        posterior_of(tmp_path / "modal_properties.csv", tmp_path / "scatter.csv", tmp_path / "cal" / "ga_best.json",
+                     "beam", cal, PosteriorSettings())
+    text = str(err.value)
+    assert "two different modes" in text and "mode_hz: 9" in text and "slow_0.05V" in text and "fast_0.05V" in text
+    assert "noise floors" not in text and text.count(". ") == 0  # one sentence

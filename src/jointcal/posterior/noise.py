@@ -154,7 +154,7 @@ def data_problem(data: ModalData, *, noise: tuple[float, float] | None = None,
     out = []
     two = _clusters(f, q, np.asarray(data.level, dtype=float))
     if two is not None:
-        lo, hi = (np.asarray(data.run_id)[g] for g in two)
+        lo, hi = (np.asarray(data.run_id)[np.sort(g)] for g in two)  # in the table's order
         f_lo, f_hi = (float(np.median(f[g])) for g in two)
         out.append(("two_modes", f"{where}: the runs of assembly {a!r} read two different modes, f_res near "
                     f"{f_lo:.4g} Hz ({', '.join(lo[:4])}{', ...' if len(lo) > 4 else ''}) and near {f_hi:.4g} Hz "
