@@ -46,7 +46,8 @@ def goodness_of_fit(lp: LogPosterior, theta: np.ndarray, p_reject: float = P_REJ
     test = fit_test(lp, theta)
     stat, dof, p = test["fit_chi2"], int(test["fit_dof"]), test["fit_p"]
     scale = scale_words(sources)
-    verdict = (f"the data reject the model at the precision of {scale} (model error, not noise, sets the "
+    precision = "the repeats" if tuple(sources) == ("repeats", "repeats") else scale
+    verdict = (f"the data reject the model at the precision of {precision} (model error, not noise, sets the "
                "noise scales, which widen the intervals)" if p < p_reject else f"consistent with {scale}")
     return ratios, (f"Fit of the GA optimum: rms relative residuals {rms[0]:.2g} (frequency) and {rms[1]:.2g} "
                     f"(damping) = {ratios[0]:.1f} and {ratios[1]:.1f} x {scale}; chi-square {stat:.0f} "
