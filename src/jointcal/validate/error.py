@@ -106,8 +106,9 @@ def own_noise(frames: Mapping[str, pd.DataFrame], metrics: pd.DataFrame, *, degr
     (a contiguous stretch of the sweep, cut in pieces of about ``chunk`` frames) are fitted,
     piece by piece, by a polynomial of ``degree`` in f; the
     residual variance (ddof = degree + 1) is pooled over stretches and runs, weighted by
-    their degrees of freedom. A shape the polynomial cannot follow adds to it, so it errs
-    towards a larger scale (a smaller E).
+    their degrees of freedom. A shape the polynomial cannot follow adds to it (a larger
+    scale, a smaller E); noise correlated over neighbouring frames (overlapping windows) is
+    partly followed by it (a smaller scale, a larger E).
 
     Parameters
     ----------
