@@ -9,6 +9,7 @@ bounds from the data), and the calibrated curve passes within 0.2% of every run'
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -19,6 +20,9 @@ import pytest
 
 from _campaign import workflow_copy
 from jointcal.calibrate import DEFAULT_BOUNDS
+from jointcal.posterior.fit import P_REJECT
+from jointcal.report.summary import fmt
+from jointcal.report.verdict import HOLDS_E
 
 REAL = Path(__file__).resolve().parents[2] / "shared" / "real" / "unesp-bert-mode1"
 
@@ -49,3 +53,11 @@ def test_a_voltage_driven_real_campaign_runs_end_to_end_with_the_default_config(
     assert any((out / "validation" / "bert_5Nm" / "m18" / "envelopes" / "traces").glob("*.csv"))
     assert "per unit modal mass" in (out / "posterior" / "bert_5Nm" / "m18" / "constraints.txt").read_text()
     assert not (out / "discrepancy").exists()  # the base-driven rig's library is not run on a voltage campaign
+    # the verdict's first answer agrees with the chi-square it shows (and with E): Yes only when both pass
+    page = (out / "report" / "summary.html").read_text()
+    answer = re.search(r"reproduce the measured envelopes\?</b> <b>(Yes|No)</b>", page).group(1)
+    with np.load(out / "posterior" / "bert_5Nm" / "chain.npz") as z:
+        p, chi2, dof = float(z["fit_p"]), float(z["fit_chi2"]), int(z["fit_dof"])
+    print(f"verdict: {answer}; chi-square {chi2:.4g} for {dof} dof, p = {p:.2g}; E = {summary['E']:.3g}")
+    assert (answer == "Yes") == (p >= P_REJECT and summary["E"] <= HOLDS_E)
+    assert f"chi-square {fmt(chi2)} for {dof} degrees of freedom" in page  # the test the answer stands on

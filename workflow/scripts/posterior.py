@@ -15,7 +15,7 @@ import numpy as np
 from jointcal.calibrate import CalibrateSettings, CalibrationInputError, read_modal
 from jointcal.io import write_csv_atomic
 from jointcal.posterior import PosteriorSettings, run_posterior
-from jointcal.posterior.identified import identified_table
+from jointcal.posterior.identified import identified_table, unsettled
 
 
 def write_identified(smk, cal: CalibrateSettings, post: PosteriorSettings) -> str:
@@ -23,12 +23,14 @@ def write_identified(smk, cal: CalibrateSettings, post: PosteriorSettings) -> st
     cal = cal.resolved(json.loads(Path(smk.input.best).read_text()))
     data = read_modal(smk.input.modal, smk.wildcards.assembly, damping=cal.damping)
     with np.load(smk.output.chain) as z:
-        table, _ = identified_table(z["samples"], [str(n) for n in z["sample_names"]], cal.space, data.q, data.f,
-                                    data.zeta, m=cal.m, model=cal.model, viscous=cal.viscous,
-                                    ratio=post.constrained_ratio)
+        names = [str(n) for n in z["sample_names"]]
+        why_not = unsettled({k: z[k] for k in z.files}, names, tau_factor=post.tau_factor)
+        table, _ = identified_table(z["samples"], names, cal.space, data.q, data.f, data.zeta, m=cal.m,
+                                    model=cal.model, viscous=cal.viscous, ratio=post.constrained_ratio,
+                                    why_not=why_not)
     write_csv_atomic(table, smk.output.identified)
     return ("identified: " + ", ".join(table.loc[table["identified"], "quantity"]) + "; left to the bounds: "
-            + ", ".join(table.loc[~table["identified"], "quantity"]))
+            + ", ".join(table.loc[~table["identified"], "quantity"]) + (f" ({why_not})" if why_not else ""))
 
 
 def main(smk) -> None:

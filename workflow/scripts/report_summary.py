@@ -15,14 +15,20 @@ from jointcal._workflow import unit_labels, unit_of
 from jointcal.calibrate import PARAMS, CalibrateSettings, model_words, read_modal
 from jointcal.io import write_bytes_atomic
 from jointcal.posterior import NAMES, PosteriorSettings, find_modes
+from jointcal.posterior.noise import scale_words
 from jointcal.report.summary import bound_hits, chain_status, ga_best_point, landing_html, summary_html
 from jointcal.report.table_3_2 import table_3_2_html
-from jointcal.posterior.identified import identified_at
+from jointcal.posterior.identified import identified_at, settled
 from jointcal.report.verdict import corrected_holds, identified_html, verdict_html, verdict_items
 
 
 def _json(files, names):
     return {a: json.loads(Path(p).read_text()) for a, p in zip(names, files)} if files else {}
+
+
+def _sources(arrays: dict) -> tuple:
+    """Where the chi-square's noise scales came from (chain.npz's noise_source; older chains: the repeats)."""
+    return tuple(str(v) for v in arrays["noise_source"]) if "noise_source" in arrays else ("repeats", "repeats")
 
 
 def _details(arrays: dict, modes: pd.DataFrame | None, identified: pd.DataFrame) -> str:
@@ -31,7 +37,7 @@ def _details(arrays: dict, modes: pd.DataFrame | None, identified: pd.DataFrame)
     if "fit_p" in arrays:
         ratio = np.asarray(arrays["fit_ratio"], dtype=float)
         lines.append(f"Fit of the polished optimum: rms relative residuals {ratio[0]:.1f} (frequency) and {ratio[1]:.1f} "
-                     f"(damping) x the repeat scatter; chi-square {float(arrays['fit_chi2']):.0f} for "
+                     f"(damping) x {scale_words(_sources(arrays))}; chi-square {float(arrays['fit_chi2']):.0f} for "
                      f"{int(arrays['fit_dof'])} degrees of freedom (p = {float(arrays['fit_p']):.1g}).")
     if modes is not None and len(modes) and modes["mode"].max() > 0:
         fixed = [p for p in identified.loc[identified["identified"] & (identified["kind"] == "parameter"), "quantity"]]
@@ -50,7 +56,7 @@ def main(smk) -> None:
     post = PosteriorSettings.from_config(smk.params.posterior)
     names = unit_labels(smk.input.best)  # assembly (and mode: jointcal._workflow)
     status, modes, fits, details = {}, {}, {}, {}
-    identified = {a: pd.read_csv(p) for a, p in zip(names, smk.input.identified)}
+    identified = {a: settled(pd.read_csv(p)) for a, p in zip(names, smk.input.identified)}  # as a user is told
     for a, chain in zip(names, smk.input.chain):
         with np.load(chain) as z:
             arrays = {k: z[k] for k in z.files}
@@ -58,7 +64,7 @@ def main(smk) -> None:
         if "sample_mode" in arrays:
             modes[a] = find_modes(arrays["samples"], NAMES, labels=arrays["sample_mode"])
         if "fit_p" in arrays:
-            fits[a] = {k: float(arrays[k]) for k in ("fit_chi2", "fit_dof", "fit_p")}
+            fits[a] = {k: float(arrays[k]) for k in ("fit_chi2", "fit_dof", "fit_p")} | {"noise_source": _sources(arrays)}
         details[a] = _details(arrays, modes.get(a), identified[a])
     ga = {a: ga_best_point(pd.read_csv(p)) for a, p in zip(names, smk.input.history)}
     table = pd.read_csv(smk.input.table)

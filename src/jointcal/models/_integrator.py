@@ -86,6 +86,16 @@ def _element(code, a, b, z, v):
     return 0.0, 0.0, 0.0
 
 
+@njit(cache=True, inline="always")
+def _backbone(z, KT, R1, e, phimax, Fs):
+    """The exact Iwan joint's virgin backbone at z (in) and its tangent (R1 = R/(chi+1), e = chi+1)."""
+    a = abs(z)
+    if a >= phimax:
+        return (Fs if z > 0.0 else -Fs), 0.0
+    F = KT * a - R1 * a ** (e + 1.0) / (e + 1.0)
+    return (F if z >= 0.0 else -F), KT - R1 * a**e
+
+
 @njit(cache=True)
 def run(u, ud, maps, outputs, joint, sliders, elements, y_out, z_out):
     """Integrate from rest; write the outputs y and the joint displacement z per input sample.
@@ -100,7 +110,9 @@ def run(u, ud, maps, outputs, joint, sliders, elements, y_out, z_out):
     joint: (kind, KT, R, chi, phimax, Fs): kind 0 none, 1 exact Iwan (R and chi passed as
     R/(chi+1), chi+1), 2 Jenkins sliders (a test reference; KT = sum of their stiffnesses).
     sliders: (sk, sphi), the sliders' stiffnesses and slip displacements.
-    elements: (codes (n_e,), coefs (n_e, 2)), the element table sorted by code.
+    elements: (codes (n_e,), coefs (n_e, 2)), the element table sorted by code. Code 4 (a backbone
+    share s, exact Iwan joint only) replaces the share s of the joint's hysteretic force by the
+    elastic force along its virgin backbone: F = (1 - s) F_iwan(history) + s F_b(z).
     """
     H, Gsub, Wub, Phi, Gf, lz, lv, az, bzu, bzf = maps
     cy, dyu, dyf = outputs
@@ -163,6 +175,8 @@ def run(u, ud, maps, outputs, joint, sliders, elements, y_out, z_out):
             # evaluate the joint once, at the predicted motion, and commit its state
             Fj = 0.0
             Kd = 0.0
+            Fiw = 0.0
+            Kiw = 0.0
             zp = z1
             if jkind != 0:
                 turn = False
@@ -175,6 +189,8 @@ def run(u, ud, maps, outputs, joint, sliders, elements, y_out, z_out):
                     zt = z0
                 if jkind == 1:
                     F, K, ns, d = advance(su, sF, ns, d, z1, zt, turn, KT, R, chi, phimax, Fs)
+                    Fiw = F
+                    Kiw = K
                 else:
                     F = 0.0
                     K = 0.0
@@ -201,6 +217,11 @@ def run(u, ud, maps, outputs, joint, sliders, elements, y_out, z_out):
                 rd1 = Kd * v1
                 cv = 0.0
                 for e in range(n_el):
+                    if codes[e] == 4:  # backbone share: -s (F_iwan - F_b), F_iwan moved along its tangent
+                        fb, kb = _backbone(z1, KT, R, chi, phimax, Fs)
+                        r1 -= coefs[e, 0] * (Fiw + Kiw * (z1 - zp) - fb)
+                        rd1 -= coefs[e, 0] * (Kiw - kb) * v1
+                        continue
                     fe, kz, ce = _element(codes[e], coefs[e, 0], coefs[e, 1], z1, v1)
                     r1 += fe
                     rd1 += kz * v1

@@ -12,11 +12,15 @@ element             code  force                      a                     b
 cubic spring        1     a z^3                      lbf/in^3              (unused)
 contact spring      2     a max(z - b, 0)            lbf/in (>= 0)         gap, in (>= 0)
 quadratic damper    3     a z'|z'|                   lbf s^2/in^2          (unused)
+backbone share      4     -a (F_iwan - F_b(z))       share s, [0, 1)       (unused)
 ==================  ====  =========================  ====================  =====================
 
 The table is sorted by code: the kernels evaluate the velocity-dependent elements last
 (their force enters the acceleration their tangent needs). The contact spring has no
 first-harmonic model (a mean offset, even harmonics): only the time simulation takes it.
+The backbone share (the virtual lab's non-Masing joint, `jointcal.synth.non_masing`) makes
+the exact Iwan joint's force (1 - s) F_iwan(history) + s F_b(z), F_b its virgin backbone:
+the same backbone, (1 - s) of the dissipation; only the time simulation takes it too.
 """
 from __future__ import annotations
 
@@ -26,13 +30,15 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["Element", "CUBIC_SPRING", "CONTACT_SPRING", "QUADRATIC_DAMPER", "FIRST_HARMONIC",
-           "cubic_spring", "contact_spring", "quadratic_damper", "element_table"]
+__all__ = ["Element", "CUBIC_SPRING", "CONTACT_SPRING", "QUADRATIC_DAMPER", "BACKBONE_SHARE", "FIRST_HARMONIC",
+           "cubic_spring", "contact_spring", "quadratic_damper", "backbone_share", "element_table"]
 
 CUBIC_SPRING = 1
 CONTACT_SPRING = 2
 QUADRATIC_DAMPER = 3
-NAMES = {CUBIC_SPRING: "cubic spring", CONTACT_SPRING: "contact spring", QUADRATIC_DAMPER: "quadratic damper"}
+BACKBONE_SHARE = 4
+NAMES = {CUBIC_SPRING: "cubic spring", CONTACT_SPRING: "contact spring", QUADRATIC_DAMPER: "quadratic damper",
+         BACKBONE_SHARE: "backbone share"}
 FIRST_HARMONIC = frozenset({CUBIC_SPRING, QUADRATIC_DAMPER})  # the envelope kernel has their describing functions
 
 
@@ -52,6 +58,9 @@ class Element:
             raise ValueError(f"element code {self.code!r} is not one of {sorted(NAMES)} ({', '.join(NAMES.values())}).")
         if not (np.all(np.isfinite(self.a)) and np.all(np.isfinite(self.b))):
             raise ValueError(f"{NAMES[self.code]}: coefficients must be finite, got a={self.a!r}, b={self.b!r}.")
+        if self.code == BACKBONE_SHARE and not np.all((np.asarray(self.a) >= 0) & (np.asarray(self.a) < 1)):
+            raise ValueError(f"backbone share: s must lie in [0, 1) (the share of the joint's force made elastic), "
+                             f"got {self.a!r}.")
         if self.code == CONTACT_SPRING and not np.all((np.asarray(self.a) >= 0) & (np.asarray(self.b) >= 0)):
             raise ValueError("contact spring: stiffness and gap must be >= 0 (a contact that pushes back once the "
                              f"gap closes), got {self.a!r} and {self.b!r}.")
@@ -70,6 +79,11 @@ def contact_spring(k: ArrayLike, gap_in: ArrayLike = 0.0) -> Element:
 def quadratic_damper(c2: ArrayLike) -> Element:
     """c2 z'|z'| beside the joint, c2 in lbf s^2/in^2."""
     return Element(QUADRATIC_DAMPER, c2)
+
+
+def backbone_share(s: ArrayLike) -> Element:
+    """(1 - s) F_iwan(history) + s F_b(z) in place of the joint's force: s of it elastic along its backbone."""
+    return Element(BACKBONE_SHARE, s)
 
 
 def element_table(elements: Sequence[Element], batch: Callable[[ArrayLike], NDArray] | None = None

@@ -27,8 +27,9 @@ posterior spread comes from, with a local Laplace approximation at each posterio
 """
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -41,7 +42,7 @@ from ..models import derived, dissipation
 from .fisher import PRIOR_PRECISION, fisher, fixed_directions, free_share, unit_jacobian
 
 __all__ = ["Quantity", "quantities", "unit_jacobian", "fisher", "free_share", "fixed_directions",
-           "identified_table", "identified_at", "PRIOR_PRECISION"]
+           "identified_table", "identified_at", "unsettled", "settled", "PRIOR_PRECISION"]
 
 
 
@@ -111,7 +112,7 @@ def quantities(q: ArrayLike, *, m: float, model: str = "harmonic_balance", visco
 
 def identified_table(samples: ArrayLike, names: Sequence[str], space: ParamSpace, q: ArrayLike, f: ArrayLike,
                      zeta: ArrayLike, *, m: float, model: str = "harmonic_balance", viscous: str = "dashpot",
-                     ratio: float = 0.5) -> tuple[pd.DataFrame, NDArray[np.float64]]:
+                     ratio: float = 0.5, why_not: str = "") -> tuple[pd.DataFrame, NDArray[np.float64]]:
     """Every candidate quantity with its 90% interval and whether the data identify it.
 
     Parameters
@@ -131,13 +132,19 @@ def identified_table(samples: ArrayLike, names: Sequence[str], space: ParamSpace
     ratio : float
         Spread ratio below which a direction counts as fixed by the data (the posterior's
         ``constrained_ratio``).
+    why_not : str
+        `unsettled`'s sentence for a chain that did not converge or has separated modes,
+        kept in the ``why_not`` column of the parameters and combinations: `settled` then
+        reports none of them identified (the curves at the measured amplitudes, fixed by the
+        read-outs themselves, still are). ``identified`` stays the local information's
+        judgement, which the design stage reads to choose what the next test must fix.
 
     Returns
     -------
     table : pandas.DataFrame
         quantity, unit, kind, log, q_in, q05, median, q95 (physical), prior_lo, prior_hi
         (parameters), free_share (median over the draws), identified (free_share < 0.5),
-        fixed_directions (median count over the draws).
+        fixed_directions (median count over the draws), why_not.
     info : ndarray, shape (P, 6, 6)
         The data's Fisher information at each draw (unit cube), for reuse.
     """
@@ -166,7 +173,8 @@ def identified_table(samples: ArrayLike, names: Sequence[str], space: ParamSpace
         rows.append(dict(quantity=qt.name, unit=qt.unit, kind=qt.kind, log=qt.log, q_in=qt.q_in, q05=q05,
                          median=q50, q95=q95, prior_lo=space.lo[i] if i is not None else np.nan,
                          prior_hi=space.hi[i] if i is not None else np.nan, free_share=med,
-                         identified=bool(med < 0.5), fixed_directions=n_fixed))
+                         identified=bool(med < 0.5), fixed_directions=n_fixed,
+                         why_not=why_not if qt.kind != "curve" else ""))
     return pd.DataFrame(rows), info
 
 
@@ -211,3 +219,66 @@ def identified_at(theta: ArrayLike, sigma: ArrayLike, q: ArrayLike, space: Param
         share = free_share(np.eye(th.shape[1])[space.index(p)][None], info, cov, ratio=ratio)
         out[p] = bool(share[0] < 0.5)
     return out
+
+
+def unsettled(chain: Mapping[str, Any], names: Sequence[str], *, tau_factor: float = 50.0,
+              params: Sequence[str] = ("Fs", "KT", "chi", "beta", "k", "zeta_v")) -> str:
+    """Why a chain cannot identify a parameter on its own, with what to run ("" when it can).
+
+    A chain shorter than ``tau_factor`` autocorrelation times has not forgotten where its
+    walkers started, and one with separated modes (`jointcal.posterior.modes`) has a median
+    between them that describes neither: neither gives a parameter as identified.
+
+    Parameters
+    ----------
+    chain : mapping
+        ``chain.npz``'s arrays: tau_history, converged, stop_reason, projected_steps, samples,
+        sample_mode.
+    names : sequence of str
+        The samples' column names (``sample_names``).
+    tau_factor : float
+        ``posterior.tau_factor``.
+    params : sequence of str
+        The parameters located in each mode's words.
+
+    Returns
+    -------
+    str
+        One or two sentences (the cause and the setting or test that settles it), or "".
+    """
+    why = []
+    hist = np.asarray(chain["tau_history"], dtype=float)
+    n, tau = float(hist[-1, 0]), float(np.max(hist[-1, 1:]))
+    if not bool(chain["converged"]):
+        need = float(chain.get("projected_steps", np.nan))
+        need = need if np.isfinite(need) and need > n else tau_factor * tau * 1.2
+        steps = int(np.ceil(need / 1000.0) * 1000)
+        why.append(f"the posterior did not converge ({n / tau:.1f} of the {tau_factor:g} autocorrelation times "
+                   f"posterior.tau_factor asks for); run it longer with `posterior: {{max_steps: {steps}, "
+                   "stop_projected: 0}` in a config file (the chain resumes from its checkpoint)")
+    if "sample_mode" in chain and int(np.max(chain["sample_mode"])) > 0:
+        from .modes import find_modes
+
+        modes = find_modes(np.asarray(chain["samples"], dtype=float), list(names), labels=chain["sample_mode"])
+        parts = []
+        for k, g in modes.groupby("mode"):
+            g = g.set_index("param")
+            loc = ", ".join(f"{p} {g.loc[p, 'median']:.3g}" for p in params if p in g.index)
+            parts.append(f"mode {k + 1} ({100 * g['weight'].iloc[0]:.0f}% of the draws): {loc}")
+        why.append(f"the posterior has {int(modes['mode'].max()) + 1} separated modes ({'; '.join(parts)}); "
+                   "a test that tells them apart (a level past the macroslip onset of one of them), or "
+                   "calibrate.bounds that keep one, settles which holds")
+    if not why:
+        return ""
+    return ("No parameter is identified from this chain alone: " + "; and ".join(why) + ".")
+
+
+def settled(table: pd.DataFrame) -> pd.DataFrame:
+    """``identified.csv`` as a user is told it: a row with a `unsettled` reason (``why_not``) is not identified.
+
+    A table without the column (written before it existed) is returned as it is.
+    """
+    if "why_not" not in table:
+        return table
+    why = table["why_not"].fillna("").astype(str)
+    return table.assign(identified=table["identified"].astype(bool) & (why == ""), why_not=why)

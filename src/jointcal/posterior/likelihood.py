@@ -69,7 +69,8 @@ class LogPosterior:
     def __post_init__(self) -> None:
         lo = self.noise_lo
         if not (np.all(np.isfinite(lo)) and np.all(10.0**lo < np.asarray(self.noise_max))):
-            raise ValueError(f"noise floors {10.0**lo} must be finite and below noise_max {self.noise_max}")
+            raise ValueError(f"noise floors {10.0**lo} must be finite and below noise_max {self.noise_max}; raise "
+                             "posterior.noise_max, or find the runs that scatter (jointcal.posterior.noise.data_problem)")
 
     @cached_property  # read at every evaluation: computed once
     def q_ref(self) -> float:

@@ -11,8 +11,9 @@ Outputs in ``out_dir`` (all written atomically):
   ``converged``, ``stop_reason`` ("converged", "max_steps" or "projected"),
   ``projected_steps``, ``sample_mode`` (the separated mode of each draw, 0 = heaviest,
   `jointcal.posterior.modes`), ``fit_ratio`` (rms relative residuals of the GA optimum
-  over the repeat scatter, frequency and damping), ``fit_chi2``, ``fit_dof``, ``fit_p`` (its
-  chi-square test against the repeat scatter, `fit_test`) and emcee's RandomState (``rs_*``);
+  over the noise scales, frequency and damping), ``fit_chi2``, ``fit_dof``, ``fit_p`` (its
+  chi-square test against them, `fit_test`), ``noise_source`` (where each scale came from:
+  'repeats', 'own' or 'floor', `jointcal.posterior.noise`) and emcee's RandomState (``rs_*``);
 * ``constraints.txt`` -- convergence (and why the chain stopped), the fit of the optimum
   against the repeat scatter, the modes, then one sentence per parameter and correlation;
 * ``predictive.csv`` -- q_in, f_q05, f_q50, f_q95, zeta_q05, zeta_q50, zeta_q95.
@@ -32,21 +33,22 @@ from pathlib import Path
 
 import numpy as np
 
-from ..calibrate.data import CalibrationInputError, ModalData, read_modal
+from ..calibrate.data import CalibrationInputError, ModalData, read_modal, read_table
 from ..calibrate.kind import model_words
 from ..calibrate.settings import CalibrateSettings
 from ..io import write_bytes_atomic, write_csv_atomic
 from .likelihood import LogPosterior
 from .modes import find_modes, mode_labels, modes_text
+from .fit import P_REJECT, fit_test, goodness_of_fit
+from .noise import data_problem, noise_scale
 from .sampler import ChainResult, random_state_arrays, random_state_tuple, run_chain
 from .settings import PosteriorSettings
 from .summary import burn_in, constraints_text, predictive_band, summarize
 
-__all__ = ["OUTPUTS", "OBSERVED", "P_REJECT", "start_ball", "run_posterior", "goodness_of_fit",
+__all__ = ["OUTPUTS", "OBSERVED", "P_REJECT", "start_ball", "run_posterior", "posterior_of", "goodness_of_fit",
            "fit_test"]
 
 OUTPUTS = ("summary.csv", "chain.npz", "constraints.txt", "predictive.csv")
-P_REJECT = 1e-3  # chi-square probability below which the data reject the model
 OBSERVED = ("Fs", "KT", "beta", "k")  # parameters whose own tau also counts in the stopping rule (y mixes them)
 
 
@@ -65,51 +67,6 @@ def start_ball(lp: LogPosterior, theta: np.ndarray, ps: PosteriorSettings) -> np
     return lp.to_y(x0)
 
 
-def goodness_of_fit(lp: LogPosterior, theta: np.ndarray, p_reject: float = P_REJECT) -> tuple[list[float], str]:
-    """How far the GA optimum misses the data, against the repeat scatter (the noise floors).
-
-    Parameters
-    ----------
-    lp : LogPosterior
-        Data and noise floors (``lp.data.rel_noise``: relative scatter of f and zeta).
-    theta : ndarray, shape (n,)
-        The optimum in `lp.space` (Fs lbf, KT lbf/in, chi, beta, k lbf/in, zeta_v, and any grown parameter).
-    p_reject : float
-        Chi-square probability below which the sentence says the data reject the model.
-
-    Returns
-    -------
-    ratios : list of float
-        rms relative residual of f and of zeta divided by its repeat scatter.
-    sentence : str
-    """
-    x = lp.space.to_unit(theta) * (lp.space.x_hi - lp.space.x_lo) + lp.space.x_lo
-    r_f, r_z = lp.residuals(x[None])
-    s_f, s_z = lp.data.rel_noise
-    rms = [float(np.sqrt(np.mean(r_f**2))), float(np.sqrt(np.mean(r_z**2)))]
-    ratios = [rms[0] / s_f, rms[1] / s_z]
-    test = fit_test(lp, theta)
-    stat, dof, p = test["fit_chi2"], int(test["fit_dof"]), test["fit_p"]
-    verdict = ("the data reject the model at the precision of the repeats (model error, not noise, sets the "
-               "noise scales, which widen the intervals)" if p < p_reject else
-               "consistent with the repeat scatter")
-    return ratios, (f"Fit of the GA optimum: rms relative residuals {rms[0]:.2g} (frequency) and {rms[1]:.2g} "
-                    f"(damping) = {ratios[0]:.1f} and {ratios[1]:.1f} x the repeat scatter; chi-square {stat:.0f} "
-                    f"for {dof} degrees of freedom (p = {p:.1g}): {verdict}.")
-
-
-def fit_test(lp: LogPosterior, theta: np.ndarray) -> dict[str, float]:
-    """The chi-square test of `goodness_of_fit` as numbers: fit_chi2, fit_dof, fit_p (stored in chain.npz)."""
-    from scipy.stats import chi2
-
-    x = lp.space.to_unit(theta) * (lp.space.x_hi - lp.space.x_lo) + lp.space.x_lo
-    r_f, r_z = lp.residuals(x[None])
-    s_f, s_z = lp.data.rel_noise
-    stat = float(np.sum((r_f / s_f) ** 2) + np.sum((r_z / s_z) ** 2))
-    dof = max(2 * r_f.size - len(theta), 1)
-    return {"fit_chi2": stat, "fit_dof": float(dof), "fit_p": float(chi2.sf(stat, dof))}
-
-
 def _npz(arrays: dict) -> bytes:
     buf = io.BytesIO()
     np.savez(buf, **arrays)
@@ -117,17 +74,41 @@ def _npz(arrays: dict) -> bytes:
 
 
 def _read(modal_csv, scatter_csv, ga_best_json, assembly: str, cal: CalibrateSettings,
-          ps: PosteriorSettings) -> tuple[ModalData, dict, CalibrateSettings, np.ndarray, list[str]]:
-    """Step 1, read: the assembly's modal data, the calibration's optimum and the settings it was made with."""
+          ps: PosteriorSettings) -> tuple[ModalData, dict, CalibrateSettings, np.ndarray, list[str], tuple[str, str]]:
+    """Step 1, read: the assembly's modal data with its noise scales (`noise_scale`), the calibration's
+    optimum and the settings it was made with."""
     data = read_modal(modal_csv, assembly, scatter_csv=scatter_csv, damping=cal.damping,  # type: ignore[arg-type]
                       floors=dict(ps.rel_std_floor))
+    data, sources, own = noise_scale(data, read_table(scatter_csv), dict(ps.rel_std_floor))
     best = json.loads(Path(ga_best_json).read_text())
     cal = cal.resolved(best)  # the model kind, mass and bounds the calibration used
     for key in ("model", "viscous", "damping"):
         if best.get(key) != getattr(cal, key):
             raise CalibrationInputError(f"{ga_best_json}: it was calibrated with {key} {best.get(key)!r}, "
                                         f"the config now says {getattr(cal, key)!r}; rerun the calibrate stage.")
-    return data, best, cal, cal.space.vector(best), list(data.notes)
+    return data, best, cal, cal.space.vector(best), [*data.notes, *own], sources
+
+
+def posterior_of(modal_csv, scatter_csv, ga_best_json, assembly: str, cal: CalibrateSettings, ps: PosteriorSettings
+                 ) -> tuple[LogPosterior, dict, CalibrateSettings, np.ndarray, list[str], tuple[str, str]]:
+    """The log-posterior the chain samples, without sampling: read (`_read`), stop on what in the data makes it
+    meaningless (`data_problem`: two modes, noise above noise_max), and build it. `fit_test` of it at the
+    returned optimum is the chi-square the verdict shows.
+
+    Returns
+    -------
+    lp, best, cal, theta, notes, sources
+        The LogPosterior, ga_best.json, the resolved settings, the optimum, notes for the log and the
+        noise scales' sources.
+    """
+    data, best, cal, theta, notes, sources = _read(modal_csv, scatter_csv, ga_best_json, assembly, cal, ps)
+    noise_max = (ps.noise_max["frequency"], ps.noise_max["damping"])
+    problems = data_problem(data, noise_max=noise_max, where=str(modal_csv))
+    stop = [text for kind, text in problems if kind in ("two_modes", "noise")]
+    if stop:  # the sentence names the cause in the data and the fix
+        raise CalibrationInputError(stop[0])
+    lp = LogPosterior(data, cal.space, cal.m, cal.model, cal.viscous, noise_max)
+    return lp, best, cal, theta, notes + [text for _, text in problems], sources
 
 
 def _fingerprint(data: ModalData, theta: np.ndarray, cal: CalibrateSettings, ps: PosteriorSettings) -> str:
@@ -234,20 +215,20 @@ def run_posterior(modal_csv: str | os.PathLike[str], scatter_csv: str | os.PathL
     notes : list of str
         Lines for the log (floors used, resume, convergence).
     """
-    data, best, cal, theta, notes = _read(modal_csv, scatter_csv, ga_best_json, assembly, cal, ps)
-    lp = LogPosterior(data, cal.space, cal.m, cal.model, cal.viscous,
-                      (ps.noise_max["frequency"], ps.noise_max["damping"]))
+    lp, best, cal, theta, notes, sources = posterior_of(modal_csv, scatter_csv, ga_best_json, assembly, cal, ps)
+    data = lp.data
     fingerprint = _fingerprint(data, theta, cal, ps)
     ckpt = None if checkpoint is None else Path(checkpoint)
     res = _sample(lp, theta, ps, fingerprint, _resume(ckpt, fingerprint, notes), ckpt, progress)
-    head, fit_line = _write(Path(out_dir), lp, res, theta, best, cal, ps, fingerprint)
+    head, fit_line = _write(Path(out_dir), lp, res, theta, best, cal, ps, fingerprint, sources)
     notes += [head, fit_line,
               f"noise floors (relative): frequency {data.rel_noise[0]:.3g}, damping {data.rel_noise[1]:.3g}"]
     return res, notes
 
 
 def _write(out: Path, lp: LogPosterior, res: ChainResult, theta: np.ndarray, best: dict, cal: CalibrateSettings,
-           ps: PosteriorSettings, fingerprint: str) -> tuple[str, str]:
+           ps: PosteriorSettings, fingerprint: str, sources: tuple[str, str] = ("repeats", "repeats")
+           ) -> tuple[str, str]:
     """Step 4, write: summary.csv, chain.npz (with the draws and their modes), constraints.txt, predictive.csv."""
     space, data = lp.space, lp.data
     chain_x = lp.to_x(res.chain)
@@ -264,7 +245,7 @@ def _write(out: Path, lp: LogPosterior, res: ChainResult, theta: np.ndarray, bes
     q = np.geomspace(data.q.min() / cal.curve_widen, data.q.max() * cal.curve_widen, cal.curve_points)
     band = predictive_band(space.joint(samples), q, m=cal.m, model=cal.model, viscous=cal.viscous)
     head = _chain_sentence(res, ps, burn)
-    fit_ratio, fit_line = goodness_of_fit(lp, theta)
+    fit_ratio, fit_line = goodness_of_fit(lp, theta, sources=sources)
     text = (head + "\n" + fit_line + "\n" + modes_text(modes, space.names, converged=res.converged) + "\n"
             + constraints_text(summary, chain_x, burn=burn, q_max=float(data.q.max()), ratio=ps.constrained_ratio,
                                space=space))
@@ -275,7 +256,8 @@ def _write(out: Path, lp: LogPosterior, res: ChainResult, theta: np.ndarray, bes
                     res.acceptance * res.steps)
     final.update(samples=samples, sample_names=np.array(lp.sample_names), burn=burn, converged=res.converged,
                  stop_reason=np.array(res.stop_reason), projected_steps=res.projected_steps,
-                 sample_mode=labels[pick], fit_ratio=np.asarray(fit_ratio), **fit_test(lp, theta))
+                 sample_mode=labels[pick], fit_ratio=np.asarray(fit_ratio), noise_source=np.array(sources),
+                 **fit_test(lp, theta))
     write_bytes_atomic(_npz(final), out / "chain.npz")
     out.mkdir(parents=True, exist_ok=True)
     write_bytes_atomic(text.encode(), out / "constraints.txt")

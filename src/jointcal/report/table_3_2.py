@@ -68,12 +68,15 @@ def table_3_2_html(table: pd.DataFrame, ga_points: Mapping[str, Mapping[str, flo
                 for p in PARAMS}
         lo = {p: float(g.loc[p, "posterior_q05"]) for p in PARAMS}
         hi = {p: float(g.loc[p, "posterior_q95"]) for p in PARAMS}
+        t = identified.get(name) if identified else None
+        why = {} if t is None or "why_not" not in t else dict(zip(t["quantity"], t["why_not"].fillna("").astype(str)))
         cells = []
         for p in PARAMS:
             r = g.loc[p]
             if free[p]:
-                cells.append(_cell(f"<i>not identified</i><br><small>spans {fmt(lo[p])} to {fmt(hi[p])} (bounds)</small>",
-                                   "free"))
+                cause = "chain not settled" if why.get(p) else "bounds"  # jointcal.posterior.identified.unsettled
+                cells.append(_cell(f"<i>not identified</i><br><small>spans {fmt(lo[p])} to {fmt(hi[p])} ({cause})"
+                                   "</small>", "free"))
                 continue
             edge = _touches(p, lo[p], hi[p], bounds) if bounds else None
             note = f"<br><small>(touches {edge} bound)</small>" if edge else ""

@@ -3,8 +3,11 @@
 Pure functions from the stages' outputs to HTML fragments of the report's summary and landing page:
 
 1. Does the paper's model reproduce the measured envelopes? The validation stage's E
-   (1 = the repeat scatter, `jointcal.validate.error.closeness`) and the chi-square test
-   of the calibrated frequencies and damping ratios against the repeats (``chain.npz``).
+   (1 = the repeat scatter, or each run's own noise without repeats,
+   `jointcal.validate.error.closeness`) and the chi-square test of the calibrated
+   frequencies and damping ratios against their noise scales (``chain.npz``). The first
+   word is Yes only when every test shown passes: E within `HOLDS_E` and the chi-square
+   not rejecting (`first_answer`).
 2. What did the discrepancy stage name, and what did the correction change (E before and
    after, ``diagnosis.json`` read as it is)?
 3. The identified quantities of the model that holds: the corrected one where an effect
@@ -26,11 +29,13 @@ import numpy as np
 import pandas as pd
 
 from ..calibrate.space import PARAMS
+from ..posterior.noise import scale_words as noise_words
 from ..posterior.stage import P_REJECT
-from ..validate.error import closeness
+from ..validate.error import closeness, scale_source, scale_words
 from .summary import fmt as _g
 
-__all__ = ["HOLDS_E", "named_effects", "corrected_holds", "verdict_items", "identified_html", "verdict_html"]
+__all__ = ["HOLDS_E", "first_answer", "named_effects", "corrected_holds", "verdict_items", "identified_html",
+           "verdict_html"]
 
 HOLDS_E = 2.0  # a model holds when its E is "about as close as a repeated test" (closeness)
 _WORDS = {"K0": "K0 = k + KT", "R": "R (eq. 3.5)", "D_ref": "dissipation per cycle at q_ref",
@@ -62,20 +67,50 @@ def _unit(row: pd.Series) -> str:
     return "" if row["unit"] == "-" else str(row["unit"])
 
 
+def first_answer(validation: Mapping | None, fit: Mapping | None) -> bool | None:
+    """Yes (True) only when every test shown passes: E within `HOLDS_E` and the chi-square test of the
+    frequencies and damping not rejecting (p >= `P_REJECT`); None when neither test ran."""
+    tests = []
+    if validation is not None:
+        tests.append(float(validation["E"]) <= HOLDS_E)
+    if fit is not None and np.isfinite(fit.get("fit_p", np.nan)):
+        tests.append(float(fit["fit_p"]) >= P_REJECT)
+    return all(tests) if tests else None
+
+
 def _item1(best: Mapping, validation: Mapping | None, fit: Mapping | None) -> str:
     kind = "the paper's model" if best.get("model_kind", "ministack") == "ministack" else "the calibrated mode"
-    parts = [] if validation is not None else ["The validation stage did not run."]
+    answer = first_answer(validation, fit)
+    if answer is None:
+        return "The validation stage did not run, and the posterior has no chi-square test."
+    word = "<b>Yes</b>" if answer else "<b>No</b>"
+    e_text = chi_text = ""
+    e_ok = chi_ok = None
     if validation is not None:
-        E = float(validation["E"])
-        holds = E <= HOLDS_E
-        parts.append(f"{'<b>Yes</b>' if holds else '<b>No</b>'}: {kind} against the measured envelopes, E = "
-                     f"<b>{E:.2f}</b> (1 = the repeat-to-repeat scatter): {closeness(E)}.")
+        E, src = float(validation["E"]), scale_source(validation.get("scale"))
+        e_ok = E <= HOLDS_E
+        e_text = f"E = <b>{E:.2f}</b> (1 = {scale_words(src)}): {closeness(E, src)}"
     if fit is not None and np.isfinite(fit.get("fit_p", np.nan)):
         p = float(fit["fit_p"])
-        reject = p < P_REJECT
-        parts.append(f"Its calibrated frequencies and damping ratios {'are rejected by' if reject else 'agree with'} "
-                     f"the repeats: chi-square {_g(float(fit['fit_chi2']))} for {int(fit['fit_dof'])} degrees of "
-                     f"freedom, p = {p:.1g}{' (the model, not noise, sets the misfit)' if reject else ''}.")
+        sources = tuple(str(v) for v in fit.get("noise_source", ("repeats", "repeats")))
+        chi_ok = p >= P_REJECT
+        chi_text = (f"{'agree with' if chi_ok else 'are rejected by'} "
+                    f"{'the repeats' if sources == ('repeats', 'repeats') else noise_words(sources)}: chi-square "
+                    f"{_g(float(fit['fit_chi2']))} for {int(fit['fit_dof'])} degrees of freedom, p = {p:.1g}"
+                    f"{'' if chi_ok else ' (the model, not noise, sets the misfit)'}")
+    if e_ok is False or e_ok is None and chi_ok is False or e_ok and chi_ok is not False:
+        # the first test shown carries the answer (E, else the chi-square), the other agrees or adds to it
+        parts = [f"{word}: {kind} against the measured envelopes, {e_text}." if e_text else
+                 f"{word}: {kind}'s frequencies and damping ratios {chi_text}."]
+        if e_text and chi_text:
+            parts.append(f"Its calibrated frequencies and damping ratios {chi_text}"
+                         + ("; the misfit lies in the envelopes, not in the backbone's frequencies and damping."
+                            if chi_ok and not e_ok else "."))
+    else:  # E within its scale, the chi-square rejecting: No, for the chi-square's reason
+        parts = [f"{word}: {kind}'s frequencies and damping ratios {chi_text}.",
+                 f"The envelopes alone do not show this misfit: {e_text}."]
+    if validation is None:
+        parts.append("(The validation stage did not run.)")
     return " ".join(parts)
 
 
@@ -106,7 +141,16 @@ def corrected_holds(diagnosis: Mapping | None) -> bool:
                 and float(diagnosis["metric_after"]) < float(diagnosis["metric_before"]))
 
 
-def _item3(identified: pd.DataFrame, diagnosis: Mapping | None, corrected: Mapping[str, bool] | None) -> str:
+def _why_not(identified: pd.DataFrame) -> str:
+    """The chain's reason for identifying nothing (`jointcal.posterior.identified.unsettled`), or ""."""
+    if "why_not" not in identified:
+        return ""
+    w = identified["why_not"].fillna("").astype(str)
+    return str(w[w != ""].iloc[0]) if (w != "").any() else ""
+
+
+def _item3(identified: pd.DataFrame, diagnosis: Mapping | None, corrected: Mapping[str, bool] | None,
+           rejected: bool = False) -> str:
     t = identified
     free = [str(r["quantity"]) for _, r in t.iterrows() if not r["identified"] and r["kind"] != "curve"]
     if corrected_holds(diagnosis) and corrected is not None:
@@ -136,18 +180,42 @@ def _item3(identified: pd.DataFrame, diagnosis: Mapping | None, corrected: Mappi
               f"{_g(f['median'].iloc[-1])} {_interval(f['q05'].iloc[-1], f['q95'].iloc[-1])} Hz and the damping "
               f"ratio rises from {_g(z['median'].iloc[0])} {_interval(z['q05'].iloc[0], z['q95'].iloc[0])} to "
               f"{_g(z['median'].iloc[-1])} {_interval(z['q05'].iloc[-1], z['q95'].iloc[-1])}.")
-    free_words = (f" Left to the bounds (no value is given): {', '.join(_WORDS.get(n, n) for n in free)}."
+    why = _why_not(t)
+    free_words = (f" {html.escape(why)}" if why else
+                  f" Left to the bounds (no value is given): {', '.join(_WORDS.get(n, n) for n in free)}."
                   if free else " Every parameter is identified.")
-    return f"Identified (posterior median, 90% interval): {vals or 'nothing'}.{cw}{free_words}"
+    caveat = (" These are the values of a model the tests of item 1 reject: the closest Iwan joint to the data, "
+              "biased by what it misses." if rejected and vals else "")
+    return f"Identified (posterior median, 90% interval): {vals or 'nothing'}.{cw}{free_words}{caveat}"
 
 
-def _item4(next_test: Mapping | None) -> str:
+def _not_applicable(next_test: Mapping, identified: pd.DataFrame | None) -> str:
+    """Item 4 for a campaign the design cannot plan (force- or voltage-driven), in agreement with item 3."""
+    text = "<b>No level recommended.</b> " + html.escape(str(next_test.get("reason", "")))
+    if identified is None:
+        return text + " " + html.escape(str(next_test.get("what_would_identify", "")))
+    why = _why_not(identified)
+    free = [str(r["quantity"]) for _, r in identified.iterrows() if r["kind"] == "parameter" and not r["identified"]]
+    pm = next_test.get("phi_max_interval_in") or [np.nan, np.nan]
+    q_max = float(next_test.get("largest_amplitude_in", np.nan))
+    if why:
+        return (text + " Settle the posterior first (item 3 says what to run): until then no amplitude can be "
+                "chosen to identify a parameter.")
+    if not free:
+        return text + " The data identify every parameter of the joint; no further level is needed for that."
+    if np.isfinite(q_max) and np.isfinite(pm[1]) and q_max > pm[1]:
+        return (text + f" The runs already reach {_g(q_max)} in, past the posterior's macroslip onset (phi_max "
+                f"{_interval(pm[0], pm[1])} in), yet leave {', '.join(free)} to the bounds: a higher level will not "
+                "identify them.")
+    return text + " " + html.escape(str(next_test.get("what_would_identify", "")))
+
+
+def _item4(next_test: Mapping | None, identified: pd.DataFrame | None = None) -> str:
     if next_test is None:
         return "The design stage did not run."
     r = next_test.get("recommended")
     if not r:
-        return "<b>No level recommended.</b> " + html.escape(str(next_test.get("reason", ""))) + " " + html.escape(
-            str(next_test.get("what_would_identify", "")))
+        return _not_applicable(next_test, identified)
     tg = next_test.get("targets", [])
     head = (f"<b>{r['level_g']:g} g base sweep, {r['direction']}, at {r['sweep_rate_hz_per_s']:g} Hz/s</b> "
             f"({r['duration_s']:.1f} s).")
@@ -175,10 +243,11 @@ def verdict_items(*, best: Mapping, identified: pd.DataFrame, validation: Mappin
     ``corrected``: which joint parameters the runs identify at the corrected model's point
     (`jointcal.posterior.identified.identified_at`), when the discrepancy stage named an effect.
     """
+    rejected = first_answer(validation, fit) is False and not corrected_holds(diagnosis)
     return [("Does the paper's model reproduce the measured envelopes?", _item1(best, validation, fit)),
             ("What did the discrepancy stage name, and what did the correction change?", _item2(diagnosis, best)),
-            ("What do the data identify (the model that holds)?", _item3(identified, diagnosis, corrected)),
-            ("The next test", _item4(next_test))]
+            ("What do the data identify (the model that holds)?", _item3(identified, diagnosis, corrected, rejected)),
+            ("The next test", _item4(next_test, identified))]
 
 
 def identified_html(identified: pd.DataFrame, *, title: str) -> str:
@@ -186,11 +255,16 @@ def identified_html(identified: pd.DataFrame, *, title: str) -> str:
     named as left to the bounds (their 90% range shown as a range, not a value)."""
     rows = [f"<p><b>{html.escape(title)}</b></p><table class='ident'><tr><th>quantity</th><th>identified?</th>"
             "<th>posterior median [90% interval]</th><th>share of its variance along free directions</th></tr>"]
+    why = _why_not(identified)
     for _, r in identified.iterrows():
         u = _unit(r)
         if r["identified"]:
             cell = f"{_g(r['median'])} {_interval(r['q05'], r['q95'], u)}"
             flag = "<span class='good'>yes</span>"
+        elif why and str(r.get("why_not", "") or ""):
+            cell = (f"<i>not from this chain alone</i> (its draws span {_g(r['q05'])} to {_g(r['q95'])}"
+                    f"{' ' + u if u else ''}; see below)")
+            flag = "<span class='bad'>no</span>"
         else:
             cell = (f"<i>left to the bounds</i> (posterior spans {_g(r['q05'])} to {_g(r['q95'])}"
                     f"{' ' + u if u else ''}, set by the bounds, not the data)")
@@ -198,6 +272,8 @@ def identified_html(identified: pd.DataFrame, *, title: str) -> str:
         rows.append(f"<tr><td class='lab'>{html.escape(_label(r))}</td><td>{flag}</td><td class='lab'>{cell}</td>"
                     f"<td>{float(r['free_share']):.2f}</td></tr>")
     rows.append("</table>")
+    if why:
+        rows.append(f"<p class='bad'>{html.escape(why)}</p>")
     return "\n".join(rows)
 
 

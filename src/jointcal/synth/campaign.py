@@ -23,6 +23,7 @@ from ..models import resonance_amplitude, simulate
 from ..units import G
 from . import daq
 from .hidden import effect_defaults, run_model
+from .non_masing import KEY, share_of, with_share
 from .rig_truth import rig_truth
 from .shaker import Shaker, StructureMode, simulate_rig
 from .spec import JOINT_KEYS, RIG_LEVEL, load_spec
@@ -85,14 +86,15 @@ _PLACEHOLDER_JOINT = {"Fs": 1.0, "KT": 1.0, "chi": -0.5, "beta": 0.1}
 
 def _model(truth: dict, sequence: int, effect: str, eparams: dict, also: dict | None = None):
     """The run's model: `run_model`, or its linear version for an assembly without a joint; with
-    `also` ({name, params}) the second effect is applied to the first's model."""
+    `also` ({name, params}) the second effect is applied to the first's model; with ``backbone_share``
+    s, s of the joint's force is elastic along its backbone (`jointcal.synth.non_masing`)."""
     joint = all(k in truth for k in JOINT_KEYS)
     t = truth if joint else {**truth, **_PLACEHOLDER_JOINT}
     model = run_model(t, sequence, effect, eparams)
     if also and also["name"] != "none":
         model = EFFECTS[also["name"]].apply(model, effect_defaults(also["name"], also.get("params")),
                                             {"sequence": sequence})
-    return model if joint else replace(model, iwan=None)
+    return with_share(model, float(truth.get(KEY, 0.0))) if joint else replace(model, iwan=None)
 
 
 def generate(spec: dict | str | os.PathLike, out_dir: str | os.PathLike, truth_path: str | os.PathLike) -> pd.DataFrame:
@@ -139,6 +141,9 @@ def generate(spec: dict | str | os.PathLike, out_dir: str | os.PathLike, truth_p
                                            level, rng=run_rng, ramp_s=sw["ramp_s"], tail_s=sw["tail_s"],
                                            ripple=meas["ripple"] if ref == "base" else 0.0,
                                            distortion=tuple(meas["distortion"]))
+        if ref == "base" and share_of(model) > 0:
+            raise ValueError(f"assembly {row.assembly!r}: {KEY} needs rig reference force or voltage (the base "
+                             "rig's truth rows are the Iwan joint's harmonic balance); set rig.reference.")
         if ref == "base":
             reference, resp = drive, simulate(model, drive, fs_sim, omega_h=0.3).response_g  # truth finer than any estimator
             extra = _truth_row(truth, model, row.level_g)

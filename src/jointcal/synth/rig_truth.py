@@ -14,6 +14,7 @@ from numpy.typing import NDArray
 
 from ..models import MinistackModel, harmonic_balance
 from ..models.iwan import derived
+from .non_masing import equivalent, share_of
 from .shaker import BL_E_PER_BL, Shaker, StructureMode, _structure
 
 __all__ = ["peak_amplitude", "structure_equivalent", "rig_pole", "steady_amplitude", "structure_resonance_amplitude",
@@ -24,10 +25,13 @@ def structure_equivalent(model: MinistackModel, q: float) -> tuple[float, float]
     """The structure's equivalent-linear natural frequency (Hz) and damping at amplitude q (in).
 
     First-harmonic balance of the joint (`jointcal.models.harmonic_balance`, dashpot
-    viscous term); a linear structure (no joint) gives sqrt(k/m) and zeta_v.
+    viscous term; with a backbone share, `jointcal.synth.non_masing.equivalent`); a linear
+    structure (no joint) gives sqrt(k/m) and zeta_v.
     """
     if model.iwan is None:
         return float(np.sqrt(model.k / model.m) / (2 * np.pi)), float(model.zeta_v)
+    if share_of(model) > 0:  # a non-Masing joint: its cycle integrated (jointcal.synth.non_masing)
+        return equivalent(model, q)
     p = model.iwan
     f, z = harmonic_balance(q, p.Fs, p.KT, p.chi, p.beta, model.k, model.m, model.zeta_v)
     return float(f), float(z)

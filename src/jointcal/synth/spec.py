@@ -13,8 +13,11 @@ series               list of {level_g, directions: [up, down], repeats}: the tes
                      rig (rig.reference force or voltage) level_V, the amplifier's
                      voltage amplitude (V), instead of level_g.
 assemblies           {name: {Fs, KT, chi, beta, k, zeta_v}} (Table 3.2 by default); the
-                     four joint keys may all be left out (a linear structure), and
-                     weight_lbf gives an assembly its own slug weight.
+                     four joint keys may all be left out (a linear structure),
+                     weight_lbf gives an assembly its own slug weight, and backbone_share
+                     s (force or voltage rigs) makes s of the joint's force elastic along
+                     its backbone: a joint softening more than Masing allows for its
+                     damping (`jointcal.synth.non_masing`).
 rig                  reference: base (the paper's closed-loop base-acceleration control,
                      default) | force | voltage: an open-loop electrodynamic shaker on the
                      slug (`jointcal.synth.shaker`), recording the force gauge (force_lbf,

@@ -2,7 +2,7 @@
 
 E is defined in `envelope_error`. Its scale is the measured repeat-to-repeat scatter
 (`repeat_scatter`): what the same test gives twice is the resolution below which no
-model can be judged.
+model can be judged. Where the campaign has no repeats, each run's own noise (`own_noise`).
 """
 from __future__ import annotations
 
@@ -11,7 +11,8 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 
-__all__ = ["BINS", "repeat_scatter", "envelope_error", "closeness", "describe_misfit"]
+__all__ = ["BINS", "repeat_scatter", "own_noise", "envelope_error", "scale_source", "scale_words", "closeness",
+           "describe_misfit"]
 
 BINS = (0.0, 1.0, 3.0, np.inf)  # |x| = |f/f_res - 1| / zeta: within half-power, flanks, far
 
@@ -35,10 +36,13 @@ def repeat_scatter(frames: Mapping[str, pd.DataFrame], metrics: pd.DataFrame, *,
     (ddof 1) at each grid point is binned by the distance from the group's mean
     resonance, |x| = |f/f_res - 1|/zeta in `BINS` (within the half-power band, its flanks,
     far), and pooled over groups (dof-weighted mean of variances). Each bin's scale is the
-    pooled standard deviation, never less than the floor (``floor_db``, ``floor_deg``);
-    a bin without repeats (a campaign without repeated runs) takes the largest pooled value
-    of the other bins or, if none, the floor. The floors (0.05 dB = 0.6%, 0.3 deg) are
-    about what a back-to-back accelerometer pair resolves.
+    pooled standard deviation, never less than the floor (``floor_db``, ``floor_deg``).
+    A bin without repeats (most campaigns have no repeated runs) takes the runs' own noise
+    there (`own_noise`: the scatter of each run's measured frames about a quadratic in
+    frequency, source 'own noise'), never another bin's value: a bin's scatter says
+    nothing of another's (far from resonance two sweep rates differ by their transients,
+    not by noise). Without enough frames for that, the floor (source 'floor'). The floors
+    (0.05 dB = 0.6%, 0.3 deg) are about what a back-to-back accelerometer pair resolves.
 
     Parameters
     ----------
@@ -50,7 +54,7 @@ def repeat_scatter(frames: Mapping[str, pd.DataFrame], metrics: pd.DataFrame, *,
     Returns
     -------
     DataFrame, one row per bin
-        x_lo, x_hi, sigma_mag_db, sigma_phase_deg, dof, source ('repeats', 'other bins', 'floor').
+        x_lo, x_hi, sigma_mag_db, sigma_phase_deg, dof, source ('repeats', 'own noise', 'floor').
     """
     ss = np.zeros((len(BINS) - 1, 2))
     dof = np.zeros(len(BINS) - 1)
@@ -80,16 +84,73 @@ def repeat_scatter(frames: Mapping[str, pd.DataFrame], metrics: pd.DataFrame, *,
                 dof[k] += len(g) - 1
     rows = []
     pooled = np.where(dof[:, None] > 0, np.sqrt(ss / np.maximum(dof, 1)[:, None]), np.nan)
+    own, own_dof = own_noise(frames, metrics) if (dof == 0).any() else (None, None)
     for k in range(len(BINS) - 1):
+        n = int(dof[k])
         if dof[k] > 0:
             s, src = pooled[k], "repeats"
-        elif np.isfinite(pooled).any():
-            s, src = np.nanmax(pooled, axis=0), "other bins"
+        elif own is not None and own_dof[k] > 0:
+            s, src, n = own[k], "own noise", int(own_dof[k])
         else:
             s, src = np.array([0.0, 0.0]), "floor"
         rows.append(dict(x_lo=BINS[k], x_hi=BINS[k + 1], sigma_mag_db=max(float(s[0]), floor_db),
-                         sigma_phase_deg=max(float(s[1]), floor_deg), dof=int(dof[k]), source=src))
+                         sigma_phase_deg=max(float(s[1]), floor_deg), dof=n, source=src))
     return pd.DataFrame(rows)
+
+
+def own_noise(frames: Mapping[str, pd.DataFrame], metrics: pd.DataFrame, *, degree: int = 2,
+              min_frames: int = 10, chunk: int = 24) -> tuple[np.ndarray, np.ndarray]:
+    """Each bin's noise of the measured magnitude (dB) and phase (deg), from the runs themselves.
+
+    Within every run, the in-band frames of one bin on one side of the measured resonance
+    (a contiguous stretch of the sweep, cut in pieces of about ``chunk`` frames) are fitted,
+    piece by piece, by a polynomial of ``degree`` in f; the
+    residual variance (ddof = degree + 1) is pooled over stretches and runs, weighted by
+    their degrees of freedom. A shape the polynomial cannot follow adds to it (a larger
+    scale, a smaller E); noise correlated over neighbouring frames (overlapping windows) is
+    partly followed by it (a smaller scale, a larger E).
+
+    Parameters
+    ----------
+    frames : mapping run_id -> DataFrame
+        `compare_run` frames (f_hz, mag_meas_db, phase_meas_deg, in_band).
+    metrics : DataFrame
+        `compare_run` metrics (run_id, n_frames, f_res_meas_hz, zeta_meas).
+    degree : int
+        Degree of the local polynomial.
+    min_frames : int
+        Fewest frames a piece needs to count.
+    chunk : int
+        Frames per piece (a quadratic follows the response's curvature over a few frames).
+
+    Returns
+    -------
+    sigma : ndarray, shape (bins, 2)
+        Standard deviation of magnitude (dB) and phase (deg) per bin (NaN without dof).
+    dof : ndarray of int, shape (bins,)
+    """
+    P = np.polynomial.polynomial
+    ss = np.zeros((len(BINS) - 1, 2))
+    dof = np.zeros(len(BINS) - 1, dtype=int)
+    for r in metrics[metrics["n_frames"] > 0].itertuples(index=False):
+        d = frames[r.run_id]
+        d = d[d["in_band"]]
+        f = d["f_hz"].to_numpy(float)
+        x = _offset(f, r.f_res_meas_hz, r.zeta_meas)
+        b = _bin(x)
+        v = np.vstack([d["mag_meas_db"].to_numpy(float),
+                       np.degrees(np.unwrap(np.radians(d["phase_meas_deg"].to_numpy(float))))])
+        for k in range(len(BINS) - 1):
+            for side in (x < 0, x >= 0):
+                idx = np.flatnonzero((b == k) & side & np.all(np.isfinite(v), axis=0))
+                for part in np.array_split(idx, max(1, len(idx) // chunk)):
+                    if len(part) < max(min_frames, degree + 3):
+                        continue
+                    t = (f[part] - f[part].mean()) / max(float(np.ptp(f[part])), 1e-12)
+                    ss[k] += [float(np.sum((P.polyval(t, P.polyfit(t, y[part], degree)) - y[part]) ** 2)) for y in v]
+                    dof[k] += len(part) - degree - 1
+    sigma = np.where(dof[:, None] > 0, np.sqrt(ss / np.maximum(dof, 1)[:, None]), np.nan)
+    return sigma, dof
 
 
 def envelope_error(frames: Mapping[str, pd.DataFrame], metrics: pd.DataFrame, scale: pd.DataFrame) -> dict:
@@ -155,10 +216,30 @@ def _pct(x: float) -> str:
     return f"{abs(x) * 100:.1f}%"
 
 
-def closeness(E: float) -> str:
-    """How close a model's envelopes are to the measured ones, in words, from E (1 = the repeat scatter)."""
-    return ("about as close as a repeated test" if E <= 2 else
-            "clearly outside the repeat scatter" if E > 5 else "somewhat outside the repeat scatter")
+_SCALE = {"repeats": ("the repeat-to-repeat scatter", "a repeated test", "the repeat scatter"),
+          "own noise": ("each run's own noise (no repeated runs)", "the runs' own noise", "the runs' own noise"),
+          "floor": ("the noise floor validate.floor_db and floor_deg, for want of repeats or of frames enough for "
+                    "the runs' own noise", "the noise floor", "the noise floor")}
+
+
+def scale_source(scale: object) -> str:
+    """Where E's scale came from: 'repeats' when every bin has repeats, else 'own noise' or 'floor' (the
+    weakest source any bin used); ``scale`` is `repeat_scatter`'s table or its records."""
+    src = set(pd.DataFrame(scale)["source"]) if scale is not None and len(scale) else {"repeats"}
+    return "floor" if "floor" in src else "own noise" if "own noise" in src else "repeats"
+
+
+def scale_words(source: str = "repeats") -> str:
+    """What E = 1 means, for a scale source of `scale_source`."""
+    return _SCALE.get(source, _SCALE["repeats"])[0]
+
+
+def closeness(E: float, source: str = "repeats") -> str:
+    """How close a model's envelopes are to the measured ones, in words, from E (1 = the scale of ``source``)."""
+    _, test, scatter = _SCALE.get(source, _SCALE["repeats"])
+    return (f"about as close as {test}" if E <= 2 and source == "repeats" else
+            f"within {scatter}" if E <= 1 else f"within about twice {scatter}" if E <= 2 else
+            f"clearly outside {scatter}" if E > 5 else f"somewhat outside {scatter}")
 
 
 def describe_misfit(metrics: pd.DataFrame, err: Mapping, *, level_unit: str = "g") -> str:
@@ -166,9 +247,10 @@ def describe_misfit(metrics: pd.DataFrame, err: Mapping, *, level_unit: str = "g
     m = metrics[metrics["n_frames"] > 0]
     if m.empty:
         return "no usable run to compare."
-    verdict = closeness(err["E"])
+    src = scale_source(err.get("scale"))
+    verdict = closeness(err["E"], src)
     words = [f"validation envelope error E = {err['E']:.2f} (magnitude {err['E_mag']:.2f}, phase "
-             f"{err['E_phase']:.2f}; 1 = the repeat-to-repeat scatter): {verdict}."]
+             f"{err['E_phase']:.2f}; 1 = {scale_words(src)}): {verdict}."]
     pr = float(np.nanmedian(m["peak_ratio"]))
     words.append(f"The model {'under' if pr < 1 else 'over'}-predicts the peak response by {_pct(pr - 1)} "
                  f"(median over {len(m)} runs; range {m['peak_ratio'].min():.3f} to {m['peak_ratio'].max():.3f}).")
