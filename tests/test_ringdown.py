@@ -47,6 +47,8 @@ def iwan_ringdown():
 def test_the_exact_iwan_ring_down_reads_the_harmonic_balance_backbone(iwan_ringdown):
     fs, force, acc = iwan_ringdown
     assert decay_start(fs, acc, force) == int(3.0 * fs)
+    # without the drive, from the response's envelope: within a cycle of the cut-off
+    assert abs(decay_start(fs, acc) - int(3.0 * fs)) < fs / 97.4
     bb = ringdown_backbone(acc, fs, 98.0, drive=force)
     f_t, z_t = harmonic_balance(bb["q_in"].to_numpy(), JOINT["Fs"], JOINT["KT"], JOINT["chi"], JOINT["beta"],
                                 JOINT["k"], JOINT["m"], JOINT["zeta_v"])

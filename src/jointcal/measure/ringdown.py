@@ -8,8 +8,9 @@ either swept sine or transient ring-down tests".
 The estimator (``ringdown_backbone``), in the order data flows:
 
 1. **Where the decay starts** (``decay_start``): the last sample at which the drive exceeds
-   `DRIVE_OFF` of its largest value (a drive cut to zero); without a drive channel, the largest
-   response sample after which the response only decays (an impact).
+   `DRIVE_OFF` of its largest value (a drive cut to zero); without a drive channel, the last sample
+   at which the band-passed response's envelope lies within `HOLD` of its plateau (the end of a
+   dwell's steady state, or just after an impact's peak).
 2. **One mode**: the response is band-passed around the mode, zero phase (`scipy.signal.sosfiltfilt`,
    4th-order Butterworth over f (1 -+ `BAND`)), over the whole record, so the decay's start is no edge of
    the filter; a softening mode moves by a few per cent, well inside the band. The first `SETTLE` periods
@@ -25,8 +26,9 @@ The estimator (``ringdown_backbone``), in the order data flows:
    frequency: the damped one is lower by zeta^2 / 2), ``zeta`` = sigma / w_n, and the displacement
    amplitude at its centre ``q_in`` = |a + i b| exp(-sigma t_c) G / w_n^2 (in; the response in g).
 5. **The noise floor**: the decay is read while the standard error of the window's decay rate that
-   the noise gives (the band-passed record's rms over its last `TAIL`, where the decay has died out,
-   times sqrt((J^T J)^-1) of the fit and sqrt(fs / 2B), since the band-passed noise holds one
+   the noise gives (the smaller of two upper bounds of the noise: the band-passed record's rms over
+   its last `TAIL`, where the decay has died out, and the window fit's residual rms, which also holds
+   the model's error; times sqrt((J^T J)^-1) of the fit and sqrt(fs / 2B), since the band-passed noise holds one
    independent sample in fs / 2B, B = 2 BAND f) is at most `ZETA_SE_MAX` of it, so
    that three standard errors stay within 3% in zeta (a linear decay at zeta = 0.5% under noise:
    per-window errors of 1-2% where the decay stands 80-2000x over the noise's rms, 13% at 10-20x, which
@@ -47,9 +49,10 @@ from scipy import signal
 
 from ..units import G
 
-__all__ = ["decay_start", "ringdown_backbone", "DRIVE_OFF", "BAND", "ZETA_SE_MAX", "MISFIT_MAX", "SETTLE", "TAIL"]
+__all__ = ["decay_start", "ringdown_backbone", "DRIVE_OFF", "HOLD", "BAND", "ZETA_SE_MAX", "MISFIT_MAX", "SETTLE", "TAIL"]
 
 DRIVE_OFF = 0.02  # a drive below this share of its largest value is off
+HOLD = 0.05  # without a drive: the decay starts where the envelope last lies within this share of its plateau
 BAND = 0.3  # band-pass half-width, relative to the mode's frequency
 ZETA_SE_MAX = 0.01  # a window is read while its decay rate's standard error is below this share of it
 TAIL = 0.1  # share of the record at its end whose band-passed rms is the noise (the decay has died out)
@@ -65,25 +68,36 @@ def decay_start(fs: float, response: NDArray, drive: NDArray | None = None) -> i
     fs : float
         Sample rate, Hz.
     response : ndarray, shape (n,)
-        The response (any unit).
+        The response, band-passed around the mode (any unit).
     drive : ndarray, shape (n,), optional
-        The drive (any unit); None for an impact or a record of the decay alone.
+        The drive (any unit); None for an impact, or a dwell whose drive was not recorded.
 
     Returns
     -------
     int
         With a drive, one sample after the last at which |drive| exceeds DRIVE_OFF of its largest
-        value; without, the largest |response| sample.
+        value; without, the last sample at which the response's envelope (|analytic signal|, smoothed
+        over 50 ms, the record's first and last second left out) is within `HOLD` of its plateau (the
+        median of the envelope where it exceeds half its largest value): the end of a dwell's steady
+        state, or just after an impact's peak.
     """
     if drive is not None:
         d = np.abs(np.nan_to_num(np.asarray(drive, float)))
         on = np.flatnonzero(d > DRIVE_OFF * d.max()) if d.max() > 0 else np.empty(0, int)
         if on.size == 0:
             raise ValueError("the drive channel is zero throughout: no drive was cut off; give the decay's start.")
-        if on[-1] >= d.size - int(fs):
-            raise ValueError("the drive is on until the record's last second: there is no free decay to read.")
-        return int(on[-1] + 1)
-    return int(np.argmax(np.abs(np.nan_to_num(np.asarray(response, float)))))
+        end = on[-1] + 1
+    else:
+        env = np.abs(signal.hilbert(np.nan_to_num(np.asarray(response, float))))
+        env = np.convolve(env, np.ones(max(1, int(0.05 * fs))) / max(1, int(0.05 * fs)), "same")
+        edge = min(int(fs), env.size // 8)  # the band-pass filter's and the transform's own edges
+        core = env[edge:env.size - edge]
+        plateau = np.median(core[core >= 0.5 * core.max()])  # a dwell's steady level (its start may overshoot)
+        end = edge + int(np.flatnonzero(core >= (1 - HOLD) * plateau)[-1])
+    if end >= len(response) - int(fs):
+        raise ValueError("the drive (or the response's steady state) lasts until the record's last second: there is "
+                         "no free decay to read; record at least a few seconds after the drive is cut off.")
+    return int(end)
 
 
 def _fit_window(t: NDArray, x: NDArray, w0: float) -> tuple[float, float, complex, float, float]:
@@ -146,9 +160,9 @@ def ringdown_backbone(response_g: NDArray, fs: float, f_hz: float, *, start: int
     x = np.nan_to_num(np.asarray(response_g, float))
     if not (np.isfinite(f_hz) and 0 < f_hz * (1 + BAND) < fs / 2):
         raise ValueError(f"the mode's frequency {f_hz!r} Hz must lie below the record's Nyquist frequency {fs / 2:g} Hz.")
-    i0 = decay_start(fs, x, drive) if start is None else int(start)
     sos = signal.butter(4, [f_hz * (1 - BAND), f_hz * (1 + BAND)], btype="bandpass", fs=fs, output="sos")
     y = signal.sosfiltfilt(sos, x - np.median(x))
+    i0 = decay_start(fs, y, drive) if start is None else int(start)
     n_win = max(16, int(round(cycles * fs / f_hz)))
     noise = float(np.sqrt(np.mean(y[-max(n_win, int(TAIL * y.size)):] ** 2)))  # where the decay has died out
     w0 = 2 * np.pi * f_hz
@@ -157,7 +171,8 @@ def ringdown_backbone(response_g: NDArray, fs: float, f_hz: float, *, start: int
     for lo in range(i0 + settle, y.size - n_win, max(1, n_win // 2)):
         t = (np.arange(n_win) - (n_win - 1) / 2) / fs
         w, sig, c, res, se_sig = _fit_window(t, y[lo:lo + n_win], w0)
-        se_sig *= noise * np.sqrt(fs / (4 * BAND * f_hz))  # band-passed noise: one independent sample in fs / 2B
+        window_noise = min(noise, res * abs(c) / np.sqrt(2))  # each an upper bound: the tail, the fit's residual
+        se_sig *= window_noise * np.sqrt(fs / (4 * BAND * f_hz))  # one independent noise sample in fs / 2B
         wn = float(np.hypot(w, sig))
         if not (sig > 0 and se_sig <= ZETA_SE_MAX * sig and 0.5 * w0 < w < 1.5 * w0):
             if rows:
