@@ -175,8 +175,9 @@ def ringdown_backbone(response_g: NDArray, fs: float, f_hz: float, *, start: int
         se_sig *= window_noise * np.sqrt(fs / (4 * BAND * f_hz))  # one independent noise sample in fs / 2B
         wn = float(np.hypot(w, sig))
         if not (sig > 0 and se_sig <= ZETA_SE_MAX * sig and 0.5 * w0 < w < 1.5 * w0):
-            if rows:
-                rows[-1]["flags"] = ";".join(filter(None, [rows[-1]["flags"], "noise_floor"]))
+            if not rows:  # not yet read: the loud start (the joint's distortion in the residual) may be past
+                continue
+            rows[-1]["flags"] = ";".join(filter(None, [rows[-1]["flags"], "noise_floor"]))
             break
         rows.append(dict(t_s=(lo + (n_win - 1) / 2) / fs, q_in=abs(c) * G / wn**2, f_hz=wn / (2 * np.pi),
                          zeta=sig / wn, zeta_se=se_sig / wn, misfit=res, flags="misfit" if res > MISFIT_MAX else ""))
