@@ -28,10 +28,16 @@ __all__ = ["rotating_mode_sensitivity", "N_DIRECTIONS"]
 N_DIRECTIONS = 16
 
 
-@numba.njit(cache=True)
-def _stage(z, y, r, rd, w0, p, q_ref, l_lo, l_hi, dirs, dz, dy, da, g):
-    """The equation's right-hand side Z'' at (z, y), and in da its derivative along each direction given
-    the stage's state derivatives (dz, dy): `_rotating._rhs` with its chain rule (g: work space, 16)."""
+@numba.njit(cache=True, inline="always")
+def _put(g, k, v):
+    g[0, k], g[1, k] = v.real, v.imag
+
+
+@numba.njit(cache=True, inline="always")
+def _stage(z, y, r, rd, w0, p, q_ref, l_lo, l_hi, dirs, t, out, g):
+    """The equation's right-hand side Z'' at (z, y), and in out (2, m: real and imaginary parts) its derivative
+    along each direction given the stage's state derivatives t (4, m: Re dZ, Im dZ, Re dZ', Im dZ'):
+    `_rotating._rhs` with its chain rule (g: work space, 2 x 16)."""
     az = abs(z)
     L = np.log(max(az, 1e-300) / q_ref)
     inside = l_lo < L < l_hi and az > 0.0
@@ -48,15 +54,29 @@ def _stage(z, y, r, rd, w0, p, q_ref, l_lo, l_hi, dirs, dz, dy, da, g):
     gw = -(w2 + 0.5j * phi * d * sw) * z  # d a / d ln Omega^2
     gd = -d * ((1.0 - phi) * y + 1j * ((1.0 - phi) * w0 + phi * sw) * z)  # d a / d ln D
     # each direction's own term (the state's aside): ln p[0], ln p[1], p[2], ..., p[11]
-    g[0], g[1], g[2], g[3], g[4], g[5] = gw, gd, gw * L, gw * L * L, gd * L, gd * L * L
-    g[6], g[7], g[8] = r, 1j * r, d * y - 1j * d * (sw - w0) * z
-    g[9], g[10], g[11] = -1j * rd / w0, rd / w0, gw * L * L * L
+    _put(g, 0, gw)
+    _put(g, 1, gd)
+    _put(g, 2, gw * L)
+    _put(g, 3, gw * L * L)
+    _put(g, 4, gd * L)
+    _put(g, 5, gd * L * L)
+    _put(g, 6, r)
+    _put(g, 7, 1j * r)
+    _put(g, 8, d * y - 1j * d * (sw - w0) * z)
+    _put(g, 9, -1j * rd / w0)
+    _put(g, 10, rd / w0)
+    _put(g, 11, gw * L * L * L)
     # the amplitude's share: d a / d L times dL = Re(conj(z) dz) / |z|^2, zero where L is held
     f_l = (gw * (p[2] + 2.0 * p[3] * L + 3.0 * p[11] * L * L) + gd * (p[4] + 2.0 * p[5] * L)) / (az * az) \
         if inside else 0j
-    zr, zi = z.real, z.imag
+    # d a = -stiff dZ - visc dZ' + f_l Re(conj(z) dZ), as real 2 x 4 coefficients
+    c00, c01 = -stiff.real + f_l.real * z.real, stiff.imag + f_l.real * z.imag
+    c10, c11 = -stiff.imag + f_l.imag * z.real, -stiff.real + f_l.imag * z.imag
     for j in range(dirs.size):
-        da[j] = g[dirs[j]] - stiff * dz[j] - visc * dy[j] + f_l * (zr * dz[j].real + zi * dz[j].imag)
+        out[0, j], out[1, j] = g[0, dirs[j]], g[1, dirs[j]]
+    for j in range(dirs.size):
+        out[0, j] += c00 * t[0, j] + c01 * t[1, j] - visc.real * t[2, j] + visc.imag * t[3, j]
+        out[1, j] += c10 * t[0, j] + c11 * t[1, j] - visc.imag * t[2, j] - visc.real * t[3, j]
     return a
 
 
@@ -97,46 +117,49 @@ def rotating_mode_sensitivity(r, rd, rm, rdm, w0, h, p, q_ref, l_lo, l_hi, z0, y
     Z = np.empty(n, np.complex128)
     acc = np.empty(n, np.complex128)
     dacc = np.zeros((rows.size, chain.shape[1]), np.complex128)
-    da = np.empty(m, np.complex128)
-    dz, dy = np.zeros(m, np.complex128), np.zeros(m, np.complex128)
+    st = np.zeros((4, m))  # the state's derivatives: Re dZ, Im dZ, Re dZ', Im dZ'
     for j in range(m):  # the start state's own directions
-        dz[j] = 1.0 if dirs[j] == 12 else (1j if dirs[j] == 13 else 0j)
-        dy[j] = 1.0 if dirs[j] == 14 else (1j if dirs[j] == 15 else 0j)
-    d1, d2, d3, d4 = np.empty(m, np.complex128), np.empty(m, np.complex128), np.empty(m, np.complex128), \
-        np.empty(m, np.complex128)
-    sz, sy = np.empty(m, np.complex128), np.empty(m, np.complex128)
-    g = np.zeros(N_DIRECTIONS, np.complex128)  # the start state's own terms stay 0
+        if dirs[j] >= 12:
+            st[dirs[j] - 12, j] = 1.0
+    d1, d2, d3, d4 = np.empty((2, m)), np.empty((2, m)), np.empty((2, m)), np.empty((2, m))
+    t = np.empty((4, m))
+    g = np.zeros((2, N_DIRECTIONS))  # the start state's own terms stay 0
     z, y = z0, y0
     i_row = 0
     hh = 0.5 * h
     for k in range(n):
-        a1 = _stage(z, y, r[k], rd[k], w0, p, q_ref, l_lo, l_hi, dirs, dz, dy, d1, g)
+        a1 = _stage(z, y, r[k], rd[k], w0, p, q_ref, l_lo, l_hi, dirs, st, d1, g)
         Z[k] = z
         acc[k] = a1 + 2j * w0 * y - w0 * w0 * z
         if i_row < rows.size and rows[i_row] == k:
-            for j in range(m):
-                da[j] = d1[j] + 2j * w0 * dy[j] - w0 * w0 * dz[j]
             for i in range(chain.shape[1]):
-                t = 0j
-                for j in range(m):
-                    t += chain[j, i] * da[j]
-                dacc[i_row, i] = t
+                t_re, t_im = 0.0, 0.0
+                for j in range(m):  # d acc = d a + 2 i w0 dZ' - w0^2 dZ
+                    t_re += chain[j, i] * (d1[0, j] - 2.0 * w0 * st[3, j] - w0 * w0 * st[0, j])
+                    t_im += chain[j, i] * (d1[1, j] + 2.0 * w0 * st[2, j] - w0 * w0 * st[1, j])
+                dacc[i_row, i] = t_re + 1j * t_im
             i_row += 1
         if k == n - 1:
             break
-        for j in range(m):
-            sz[j], sy[j] = dz[j] + hh * dy[j], dy[j] + hh * d1[j]
-        a2 = _stage(z + hh * y, y + hh * a1, rm[k], rdm[k], w0, p, q_ref, l_lo, l_hi, dirs, sz, sy, d2, g)
-        for j in range(m):
-            sz[j], sy[j] = dz[j] + hh * (dy[j] + hh * d1[j]), dy[j] + hh * d2[j]
-        a3 = _stage(z + hh * (y + hh * a1), y + hh * a2, rm[k], rdm[k], w0, p, q_ref, l_lo, l_hi, dirs, sz, sy, d3, g)
-        for j in range(m):
-            sz[j], sy[j] = dz[j] + h * (dy[j] + hh * d2[j]), dy[j] + h * d3[j]
-        a4 = _stage(z + h * (y + hh * a2), y + h * a3, r[k + 1], rd[k + 1], w0, p, q_ref, l_lo, l_hi, dirs, sz, sy,
-                    d4, g)
-        for j in range(m):
-            dz[j] = dz[j] + h * dy[j] + h * h / 6.0 * (d1[j] + d2[j] + d3[j])
-            dy[j] = dy[j] + h / 6.0 * (d1[j] + 2.0 * d2[j] + 2.0 * d3[j] + d4[j])
+        for q in range(2):
+            for j in range(m):
+                t[q, j] = st[q, j] + hh * st[q + 2, j]
+                t[q + 2, j] = st[q + 2, j] + hh * d1[q, j]
+        a2 = _stage(z + hh * y, y + hh * a1, rm[k], rdm[k], w0, p, q_ref, l_lo, l_hi, dirs, t, d2, g)
+        for q in range(2):
+            for j in range(m):
+                t[q, j] = st[q, j] + hh * (st[q + 2, j] + hh * d1[q, j])
+                t[q + 2, j] = st[q + 2, j] + hh * d2[q, j]
+        a3 = _stage(z + hh * (y + hh * a1), y + hh * a2, rm[k], rdm[k], w0, p, q_ref, l_lo, l_hi, dirs, t, d3, g)
+        for q in range(2):
+            for j in range(m):
+                t[q, j] = st[q, j] + h * (st[q + 2, j] + hh * d2[q, j])
+                t[q + 2, j] = st[q + 2, j] + h * d3[q, j]
+        a4 = _stage(z + h * (y + hh * a2), y + h * a3, r[k + 1], rd[k + 1], w0, p, q_ref, l_lo, l_hi, dirs, t, d4, g)
+        for q in range(2):
+            for j in range(m):
+                st[q, j] = st[q, j] + h * st[q + 2, j] + h * h / 6.0 * (d1[q, j] + d2[q, j] + d3[q, j])
+                st[q + 2, j] = st[q + 2, j] + h / 6.0 * (d1[q, j] + 2.0 * d2[q, j] + 2.0 * d3[q, j] + d4[q, j])
         z = z + h * y + h * h / 6.0 * (a1 + a2 + a3)
         y = y + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
     return Z, acc, dacc
