@@ -171,16 +171,14 @@ class Problem:
 
     def _chain(self) -> NDArray:
         """d (kernel direction) / d p, shape (N_DIRECTIONS, NP): how the scaled parameters enter the kernel."""
-        t = np.zeros((N_DIRECTIONS, NP), complex)
+        t, a_abs, qw = np.zeros((N_DIRECTIONS, NP)), self.a_abs, self.q_ref * self.ps.sig.W0
         t[0, 0], t[1, 1] = 2.0, 1.0  # ln Omega_ref^2 = ln W0^2 + 2 p[0]; ln D_ref = const + p[1]
         t[2, 2], t[3, 3], t[4, 4], t[5, 5], t[8, 8], t[11, 15] = 1.0, 1.0, 1.0, 1.0, 1.0, 1.0
-        t[6, 6], t[7, 6] = (self.a_abs * self.rot.real, self.a_abs * self.rot.imag) if self.fixed else (self.a_abs, 0.0)
-        t[7, 7] = 0.0 if self.fixed else self.a_abs
-        t[9, 9], t[10, 10] = self.a_abs, self.a_abs
+        t[6, 6], t[7, 6] = (a_abs * self.rot.real, a_abs * self.rot.imag) if self.fixed else (a_abs, 0.0)
+        t[7, 7], t[9, 9], t[10, 10] = (0.0 if self.fixed else a_abs), a_abs, a_abs
         if self.ps.free_start:
-            t[12, 18], t[13, 19] = self.q_ref, self.q_ref
-            t[14, 20], t[15, 21] = self.q_ref * self.ps.sig.W0, self.q_ref * self.ps.sig.W0
-        return t.real
+            t[12, 18], t[13, 19], t[14, 20], t[15, 21] = self.q_ref, self.q_ref, qw, qw
+        return t
 
     def _residual_columns(self, sel: NDArray) -> NDArray:
         """d (residual terms' acceleration) / d p at the steps sel, shape (sel.sum(), NP): linear in p[11:15],

@@ -47,7 +47,8 @@ backbone's ends: +0.14% at q_in on a jointed beam at eta 500); the damping's car
 ridge (`curv`). The fit
 (`scipy.optimize.least_squares`: the modal constant, the shape coefficients, Omega and D at
 q_ref, phi in [0, 1], and residual terms (B_0 + B_1 (w / W_0 - 1) + B_2 (w / W_0 - 1)^2) r_a for
-the other modes' mass or stiffness lines)
+the other modes' mass or stiffness lines; its Jacobian by the RK4 step's forward
+sensitivities, `jointcal.measure._rotating_sensitivity`, exact for the discrete model)
 returns Omega and zeta = D / (2 Omega) at the largest amplitude the fitted response
 reached, `q_in`: the equivalent-linear resonance and damping at the amplitude the
 structure reached, and the backbone below it.
