@@ -1,6 +1,7 @@
 """The rotating-frame mode's RK4 and its forward sensitivities: the sweep fit's exact Jacobian.
 
-Private: `jointcal.measure._sweep_problem.Problem.jacobian` calls `rotating_mode_sensitivity`.
+Private: `jointcal.measure._sweep_problem.Problem.misfit` calls `rotating_mode_sensitivity` and keeps the
+Jacobian for `Problem.jacobian_matrix`.
 It integrates the same discrete model as `jointcal.measure._rotating.rotating_mode` (the same RK4
 steps, the same operations in the same order, so Z and its acceleration envelope are the same
 numbers) and, beside it, the derivative of each step with respect to the mode's coefficients and
@@ -8,7 +9,8 @@ its start state: the RK4 step differentiated as it is written (each stage's deri
 chain rule through the stages before it), so the derivatives are those of the discrete model,
 exact to rounding, at any step size. The model is not holomorphic in Z (its coefficients depend
 on q = |Z|), but each direction is a real parameter, so its derivative is one complex number per
-state, and the amplitude's share is
+state (carried as its real and imaginary parts: a 2 x 4 real map per stage), and the amplitude's
+share is
 
     dL = Re(conj(Z) dZ) / |Z|^2,    L = ln(|Z| / q_ref),
 
