@@ -54,7 +54,7 @@ class Problem:
     norm: float
     n_res: int
     jacobian: str = "sensitivity"
-    memo: dict = field(default_factory=dict, compare=False, repr=False)  # the last misfit's Jacobian
+    memo: dict = field(default_factory=dict, init=False, compare=False, repr=False)  # the last Jacobian
 
     @classmethod
     def build(cls, ps: Passage, f0: float, zeta0: float, window: float, modal_phase: float | None, ridge: float,
