@@ -6,13 +6,14 @@ accepts.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
 from ._rotating import Passage, rotating_mode
+from ._rotating_sensitivity import N_DIRECTIONS, rotating_mode_sensitivity
 
 __all__ = ["Problem", "fit_from_starts", "earned_terms"]
 
@@ -52,10 +53,12 @@ class Problem:
     residual_basis: NDArray
     norm: float
     n_res: int
+    jacobian: str = "sensitivity"
+    memo: dict = field(default_factory=dict, init=False, compare=False, repr=False)  # the last Jacobian
 
     @classmethod
     def build(cls, ps: Passage, f0: float, zeta0: float, window: float, modal_phase: float | None, ridge: float,
-              curv: float, residual_ridge: float) -> Problem:
+              curv: float, residual_ridge: float, jacobian: str = "sensitivity") -> Problem:
         if not zeta0 > 0:
             raise ValueError("the swept-mode fit needs a drive, a response and start values f0 > 0, zeta0 > 0.")
         sig, sel = ps.sig, ps.sel
@@ -74,7 +77,7 @@ class Problem:
                    weight=ridge * np.sqrt(sel.sum()), ridge_terms=(residual_ridge, curv),
                    # the residual terms' basis: (w / W0 - 1)^k R for k = 0, 1, 2 in the frame (w R -> W0 R - i R')
                    residual_basis=np.stack([sig.R, -1j * sig.Rd / W0, -sig.Rdd / W0**2], axis=1),
-                   norm=float(np.linalg.norm(sig.Acc[sel] / peak)), n_res=2 * int(sel.sum()))
+                   norm=float(np.linalg.norm(sig.Acc[sel] / peak)), n_res=2 * int(sel.sum()), jacobian=jacobian)
 
     def params(self, pf: NDArray, free: NDArray) -> tuple[NDArray, NDArray]:
         """The mode's coefficients (`jointcal.measure._rotating.rotating_mode`'s p) and the residual terms."""
@@ -89,36 +92,109 @@ class Problem:
     def response(self, pf: NDArray, free: NDArray) -> tuple[NDArray, NDArray]:
         """The mode's displacement envelope Z (in) and acceleration envelope with the residual terms (in/s^2)."""
         mode, b = self.params(pf, free)
-        s, ps = self.ps.sig, self.ps
-        z0, y0 = ps.z_start, ps.y_start
-        if ps.free_start:
-            p = np.zeros(NP)
-            p[free] = pf
-            z0, y0 = z0 + self.q_ref * complex(p[18], p[19]), y0 + self.q_ref * s.W0 * complex(p[20], p[21])
+        s = self.ps.sig
+        p = np.zeros(NP)
+        p[free] = pf
+        z0, y0 = self._start(p)
         Z, acc = rotating_mode(s.R, s.Rd, s.Rm, s.Rdm, s.W0, s.h, mode, self.q_ref, self.l_lo, self.l_hi, z0, y0)
         return Z, acc + self.residual_basis @ b  # residual terms: the other modes' mass or stiffness lines
 
+    def _start(self, p: NDArray) -> tuple[complex, complex]:
+        """The integration's start state (Z in, Z' in/s): the passage's, corrected where it is fitted."""
+        ps = self.ps
+        if not ps.free_start:
+            return ps.z_start, ps.y_start
+        return (ps.z_start + self.q_ref * complex(p[18], p[19]),
+                ps.y_start + self.q_ref * ps.sig.W0 * complex(p[20], p[21]))
+
     def misfit(self, pf: NDArray, free: NDArray) -> NDArray:
-        """Relative residuals over the samples fitted, then the ridge penalties."""
-        with np.errstate(all="ignore"):  # a trial step may diverge: a large misfit, not a warning
-            res = (self.response(pf, free)[1] - self.ps.sig.Acc)[self.ps.sel] / self.peak
-        res = np.where(np.isfinite(res) & (np.abs(res) < 1e3), res, 1e3)
+        """Relative residuals over the samples fitted, then the ridge penalties. With the sensitivity
+        Jacobian, its Jacobian is computed in the same integration and kept for `jacobian_matrix`."""
         p = np.zeros(NP)
         p[free] = pf
-        residual_ridge, curv = self.ridge_terms
+        if self.jacobian == "sensitivity":
+            res, jac = self._with_jacobian(pf, free, p)
+            self.memo["at"] = (pf.copy(), free.copy(), jac)
+        else:
+            with np.errstate(all="ignore"):  # a trial step may diverge: a large misfit, not a warning
+                res = (self.response(pf, free)[1] - self.ps.sig.Acc)[self.ps.sel] / self.peak
+        res = np.where(np.isfinite(res) & (np.abs(res) < 1e3), res, 1e3)
+        return np.concatenate([res.real, res.imag, self._penalties(p, free)[0]])
+
+    def jacobian_matrix(self, pf: NDArray, free: NDArray) -> NDArray:
+        """d `misfit` / d pf, exact for the discrete model: the RK4 step's forward sensitivities
+        (`jointcal.measure._rotating_sensitivity`), shape (misfit size, free.size)."""
+        at = self.memo.get("at")
+        if at is not None and np.array_equal(at[0], pf) and np.array_equal(at[1], free):
+            return at[2]  # least squares asks for the Jacobian where it has just evaluated the misfit
+        p = np.zeros(NP)
+        p[free] = pf
+        return self._with_jacobian(pf, free, p)[1]
+
+    def _with_jacobian(self, pf: NDArray, free: NDArray, p: NDArray) -> tuple[NDArray, NDArray]:
+        """The relative residuals over the samples fitted (complex, unclamped) and the misfit's Jacobian."""
+        mode, b = self.params(pf, free)
+        s, sel = self.ps.sig, self.ps.sel
+        chain = self._chain()[:, free]  # d (kernel direction) / d pf
+        dirs = np.flatnonzero(np.any(chain != 0, axis=1))
+        if "basis" not in self.memo:  # the residual terms' columns at the samples fitted: constant
+            self.memo["basis"] = (self.residual_basis[sel], self._residual_columns(sel))
+        basis, columns = self.memo["basis"]
+        z0, y0 = self._start(p)
+        with np.errstate(all="ignore"):  # a trial step may diverge: a large misfit, not a warning
+            _, acc, dacc = rotating_mode_sensitivity(s.R, s.Rd, s.Rm, s.Rdm, s.W0, s.h, mode, self.q_ref, self.l_lo,
+                                                     self.l_hi, z0, y0, dirs, chain[dirs], np.flatnonzero(sel))
+            res = (acc[sel] + (basis[:, 0] * b[0] + basis[:, 1] * b[1] + basis[:, 2] * b[2]) - s.Acc[sel]) / self.peak
+            jac = (dacc + columns[:, free]) / self.peak
+        jac[~(np.isfinite(res) & (np.abs(res) < 1e3))] = 0.0  # a clamped residual does not move
+        jac = np.where(np.isfinite(jac), jac, 0.0)
+        return res, np.concatenate([jac.real, jac.imag, self._penalties(p, free)[1]])
+
+    def _penalties(self, p: NDArray, free: NDArray) -> tuple[NDArray, NDArray]:
+        """The ridge penalties and their derivatives in the free parameters, shape (k,) and (k, free.size)."""
         # a ridge on the nuisance terms (the modal constant's slope relative to it, the residual terms
         # relative to the peak): they stay small unless the data ask for them (an impulse-like chirp
         # cannot tell a feedthrough from the mode's response while the drive passes)
-        nuisance = np.concatenate([p[9:11] / max(np.hypot(p[6], p[7]), 1e-12),
-                                   residual_ridge * np.concatenate([p[11:15], [0.0], p[16:18]])])
-        nuisance = nuisance[free[(free >= 9) & (free < 18)] - 9]
+        residual_ridge, curv = self.ridge_terms
+        a_norm = max(np.hypot(p[6], p[7]), 1e-12)
+        nuisance = np.concatenate([p[9:11] / a_norm, residual_ridge * np.concatenate([p[11:15], [0.0], p[16:18]])])
+        grad = np.zeros((9, NP))
+        grad[np.arange(9), np.arange(9, 18)] = [1 / a_norm] * 2 + [residual_ridge] * 4 + [0.0] + [residual_ridge] * 2
+        if np.hypot(p[6], p[7]) > 1e-12:
+            grad[0:2, 6:8] = -np.outer(p[9:11], p[6:8]) / a_norm**3
+        rows = free[(free >= 9) & (free < 18)] - 9
         curvature = curv * p[5] * self.l_lo**2  # the damping's quadratic term's change over the window
-        return np.concatenate([res.real, res.imag, self.weight * nuisance, [self.weight * curvature]])
+        d_curvature = np.zeros((1, NP))
+        d_curvature[0, 5] = curv * self.l_lo**2
+        values = np.concatenate([self.weight * nuisance[rows], [self.weight * curvature]])
+        return values, self.weight * np.concatenate([grad[rows], d_curvature])[:, free]
+
+    def _chain(self) -> NDArray:
+        """d (kernel direction) / d p, shape (N_DIRECTIONS, NP): how the scaled parameters enter the kernel."""
+        t, a_abs, qw = np.zeros((N_DIRECTIONS, NP)), self.a_abs, self.q_ref * self.ps.sig.W0
+        t[0, 0], t[1, 1] = 2.0, 1.0  # ln Omega_ref^2 = ln W0^2 + 2 p[0]; ln D_ref = const + p[1]
+        t[2, 2], t[3, 3], t[4, 4], t[5, 5], t[8, 8], t[11, 15] = 1.0, 1.0, 1.0, 1.0, 1.0, 1.0
+        t[6, 6], t[7, 6] = (a_abs * self.rot.real, a_abs * self.rot.imag) if self.fixed else (a_abs, 0.0)
+        t[7, 7], t[9, 9], t[10, 10] = (0.0 if self.fixed else a_abs), a_abs, a_abs
+        if self.ps.free_start:
+            t[12, 18], t[13, 19], t[14, 20], t[15, 21] = self.q_ref, self.q_ref, qw, qw
+        return t
+
+    def _residual_columns(self, sel: NDArray) -> NDArray:
+        """d (residual terms' acceleration) / d p at the steps sel, shape (sel.sum(), NP): linear in p[11:15],
+        p[16:18]."""
+        basis = self.residual_basis[sel]
+        cols = np.zeros((basis.shape[0], NP), complex)
+        for k, (i_re, i_im) in enumerate(((11, 12), (13, 14), (16, 17))):
+            cols[:, i_re] = self.b_abs * basis[:, k]
+            cols[:, i_im] = 1j * self.b_abs * basis[:, k]
+        return cols
 
     def solve(self, p0: NDArray, free: NDArray, max_nfev: int):
         """`scipy.optimize.least_squares` of `misfit` over the free parameters from p0 (their values)."""
-        return least_squares(self.misfit, p0, args=(free,), x_scale=X_SCALE[free], bounds=(LOWER[free], UPPER[free]),
-                             max_nfev=max_nfev)
+        jac = self.jacobian_matrix if self.jacobian == "sensitivity" else "2-point"
+        return least_squares(self.misfit, p0, jac=jac, args=(free,), x_scale=X_SCALE[free],
+                             bounds=(LOWER[free], UPPER[free]), max_nfev=max_nfev)
 
     def relative(self, sol) -> float:
         """Relative RMS misfit of a solution: `SweepFit.residual`."""

@@ -47,7 +47,8 @@ backbone's ends: +0.14% at q_in on a jointed beam at eta 500); the damping's car
 ridge (`curv`). The fit
 (`scipy.optimize.least_squares`: the modal constant, the shape coefficients, Omega and D at
 q_ref, phi in [0, 1], and residual terms (B_0 + B_1 (w / W_0 - 1) + B_2 (w / W_0 - 1)^2) r_a for
-the other modes' mass or stiffness lines)
+the other modes' mass or stiffness lines; its Jacobian by the RK4 step's forward
+sensitivities, `jointcal.measure._rotating_sensitivity`, exact for the discrete model)
 returns Omega and zeta = D / (2 Omega) at the largest amplitude the fitted response
 reached, `q_in`: the equivalent-linear resonance and damping at the amplitude the
 structure reached, and the backbone below it.
@@ -66,6 +67,7 @@ state fitted with the mode, and that fit is kept where the information criterion
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -127,7 +129,8 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
                    modal_phase: float | None = None, window: float = 0.15, cutoff: float = 0.45,
                    steps_per_cycle: float = 6.0, quiet: float = 0.02, ridge: float = 0.01,
                    curv: float = 0.3, residual_ridge: float = 0.3,
-                   frequency_curvature: str = "bic", earn: float = 1.5) -> SweepFit:
+                   frequency_curvature: str = "bic", earn: float = 1.5,
+                   jacobian: Literal["sensitivity", "2-point"] = "sensitivity") -> SweepFit:
     """Fit one amplitude-dependent mode to a swept run (see the module docstring).
 
     Parameters
@@ -171,6 +174,11 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
     earn : float
         The residual terms are kept only where they pass the Bayesian information criterion and cut
         the misfit's sum of squares by this factor.
+    jacobian : {'sensitivity', '2-point'}
+        The least-squares Jacobian: the RK4 step's forward sensitivities, exact for the discrete model
+        (`jointcal.measure._rotating_sensitivity`; one integration with its derivatives per Jacobian), or
+        scipy's forward differences (one integration per free parameter; the earlier scheme, kept to
+        compare with).
     residual_ridge : float
         The residual terms' share of that penalty (0.3: other modes' lines must be free enough to
         follow a second mode's stiffness line over the band, whose curvature biased the resonance
@@ -189,13 +197,15 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
     Raises
     ------
     ValueError
-        When the record holds no drive or no response, or too few good samples.
+        When the record holds no drive or no response, or too few good samples; for an unknown `jacobian`.
     """
+    if jacobian not in ("sensitivity", "2-point"):
+        raise ValueError(f"jacobian must be 'sensitivity' or '2-point', not {jacobian!r}.")
     sig = demodulate(ref, resp_g, fs, f0, zeta0, cutoff, steps_per_cycle)
 
     def fit(free_start):
         prob = Problem.build(passage(sig, window, quiet, steps_per_cycle, free_start), f0, zeta0, window, modal_phase,
-                             ridge, curv, residual_ridge)
+                             ridge, curv, residual_ridge, jacobian)
         free = prob.free_all[~np.isin(prob.free_all, (3, 15))]  # ln Omega^2 linear in L first; its curvature if asked
         best = fit_from_starts(prob, free, f0, zeta0)
         return (prob, *earned_terms(prob, best, free, frequency_curvature, earn))
