@@ -180,3 +180,16 @@ def test_verdict_without_a_named_effect_reports_the_paper_models_identified_quan
     assert "Not run" in a2 and "force-driven" in a2
     assert "K0 = k + KT 1.63e6 [1.62e6, 1.64e6] lbf/in" in a3 and "Fs" in a3.split("Left to the bounds")[1]
     assert "No level recommended" in a4 and "force-driven" in a4
+
+
+def test_the_summary_says_which_runs_each_mode_has_and_which_modes_are_calibrated():
+    from jointcal.report.summary import modes_html
+
+    modal = pd.DataFrame({"run_id": ["w1", "w1", "w2", "w2", "u1", "n1"], "assembly": "beam",
+                          "mode": ["m18", "m95", "m18", "m95", "m95", ""], "level_V": [0.1, 0.1, 0.3, 0.3, 0.1, 0.2],
+                          "f_res_hz": [18.6, 95.1, 18.4, 94.0, 95.2, np.nan], "flags": ["", "", "", "unusable", "", "no_mode"]})
+    page = modes_html(modal)
+    assert "beam m18 (18.4-18.6 Hz): 2 runs (w1, w2); calibrated" in page
+    # m95's usable runs hold one level (0.1 V): read, named, not calibrated, and the page says why
+    assert "beam m95" in page and "3 runs (w1, w2, u1); not calibrated: read in usable runs at fewer than two levels" in page
+    assert "read at no mode" in page and "n1" in page

@@ -165,6 +165,7 @@ def summary_html(*, campaign: str, runs: pd.DataFrame, modal: pd.DataFrame, stat
     levels = "" if level is None else ", levels " + ", ".join(f"{v:g}" for v in sorted(runs[level].dropna().unique()))
     out.append(f"<p><b>Campaign</b> <code>{html.escape(campaign)}</code>: {len(runs)} runs on {n_asm} assemblies"
                f"{html.escape(levels)}{' ' + level.split('_', 1)[1] if level else ''}.</p>")
+    out.append(modes_html(modal))
     flag_rows = []
     for label, t in (("ingest (runs.csv)", runs), ("modal (modal_properties.csv)", modal)):
         n, detail = _flag_counts(t)
@@ -184,6 +185,42 @@ def summary_html(*, campaign: str, runs: pd.DataFrame, modal: pd.DataFrame, stat
         out.append("</ul>")
     out.append("</div></body></html>")
     return "\n".join(out) + "\n"
+
+
+def modes_html(modal: pd.DataFrame) -> str:
+    """Which modes each assembly's runs hold, and which are calibrated, as an HTML paragraph.
+
+    Parameters
+    ----------
+    modal : DataFrame
+        ``modal_properties.csv`` (one row per run and mode; `jointcal.measure.modes.with_modes` names the mode
+        of a table without the column).
+
+    Returns
+    -------
+    str
+        One list item per (assembly, mode): its frequency range, the runs read at it, and whether it is
+        calibrated (read in usable runs at two levels or more: `jointcal.measure.modes.units`) or why not.
+    """
+    from ..measure.modes import units, with_modes
+
+    if not len(modal) or "assembly" not in modal:
+        return ""
+    t = with_modes(modal)
+    calibrated = set(units(t))
+    items = []
+    for (asm, mode), g in t[t["mode"] != ""].groupby(["assembly", "mode"], sort=False):
+        f = pd.to_numeric(g.get("f_res_hz"), errors="coerce").dropna()
+        span = f" ({f.min():.4g}-{f.max():.4g} Hz)" if len(f) else ""
+        runs_of = ", ".join(map(str, g["run_id"]))
+        why = ("calibrated" if (str(asm), str(mode)) in calibrated
+               else "not calibrated: read in usable runs at fewer than two levels")
+        items.append(f"<li>{html.escape(f'{asm} {mode}')}{html.escape(span)}: {len(g)} runs ({html.escape(runs_of)}); "
+                     f"{why}</li>")
+    none = t[t["mode"] == ""]
+    if len(none):
+        items.append(f"<li>read at no mode (their band holds none, or no record): {html.escape(', '.join(map(str, none['run_id'])))}</li>")
+    return "<p><b>Modes</b> (one calibration per assembly and mode)</p><ul>" + "".join(items) + "</ul>"
 
 
 def _flag_counts(t: pd.DataFrame) -> tuple[int, str]:
