@@ -95,3 +95,40 @@ def test_two_amplitude_dependent_modes_each_read_at_its_own_backbone(two_modes):
     # the FRF file holds one fit per mode read
     assert set(frf["wide_0.32lbf"]["mode"]) == {"m99", "m227"}
     assert modal_units(folder / "modal_properties.csv") == [("beam", "m99"), ("beam", "m227")]
+
+
+@pytest.mark.slow
+def test_a_voltage_driven_chirp_over_two_modes_reads_each(tmp_path):
+    """The jointed beam of tests/_rigs.py on its open-loop shaker (the coil, the armature, a second, linear
+    mode at 230 Hz), chirped over both modes at eta 50 with 2% noise: both modes found in every run; the
+    jointed one on the coupled rig's pole at its q_in (0.1%, 5%), the linear one at one frequency and
+    damping whatever the level."""
+    import _rigs
+
+    from jointcal.synth import generate
+
+    f, z = _rigs.truth_curve("voltage", _rigs.Q_TARGETS[1])
+    spec = {"seed": 1, "sample_rate_hz": 2048.0, "measurement": {"noise_fraction": 0.02},
+            "sweep": {"f_start_hz": 30.0, "f_stop_hz": 260.0, "rate_hz_per_s": 50 * (f * z) ** 2, "ramp_s": 0.05,
+                      "tail_s": 1.5},
+            "series": [{"level_V": v, "directions": ["up"]} for v in _rigs.levels_V()],
+            "assemblies": {"beam": _rigs.JOINTED_BEAM},
+            "rig": {"reference": "voltage", "shaker": _rigs.SMALL_SHAKER, "second_mode": _rigs.SECOND_MODE}}
+    folder = tmp_path / "campaign"
+    generate(spec, folder, tmp_path / "truth.json")
+    man = read_manifest(folder / "manifest.csv").assign(flags="")
+
+    def load(row):
+        rec = read_run(folder / row["file"], row)
+        env, meta = envelopes(rec, row)
+        return env, {"rate_hz_per_s": meta.rate_hz_per_s}, rec
+
+    t = pd.DataFrame(campaign_modal(man, load, {})[0])
+    modes = sorted(t["mode"].unique(), key=lambda m: int(m[1:]))
+    assert len(modes) == 2 and t.groupby("mode").size().to_dict() == {m: 3 for m in modes}
+    jointed, linear = t[t["mode"] == modes[0]], t[t["mode"] == modes[1]]
+    f_t, z_t = np.array([_rigs.truth_curve("voltage", q) for q in jointed["q_in"]]).T
+    assert np.abs(jointed["f_res_hz"] / f_t - 1).max() < 1e-3 and np.abs(jointed["zeta_res"] / z_t - 1).max() < 0.05
+    assert jointed["f_res_hz"].max() / jointed["f_res_hz"].min() - 1 > 0.01  # the joint softens over the levels
+    assert linear["f_res_hz"].max() / linear["f_res_hz"].min() - 1 < 5e-4  # the linear mode does not
+    assert linear["zeta_res"].max() / linear["zeta_res"].min() - 1 < 0.05
