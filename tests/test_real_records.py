@@ -56,7 +56,7 @@ def test_a_voltage_driven_real_campaign_runs_end_to_end_with_the_default_config(
     # the verdict's first answer agrees with the chi-square it shows (and with E): Yes only when both pass
     page = (out / "report" / "summary.html").read_text()
     answer = re.search(r"reproduce the measured envelopes\?</b> <b>(Yes|No)</b>", page).group(1)
-    with np.load(out / "posterior" / "bert_5Nm" / "chain.npz") as z:
+    with np.load(out / "posterior" / "bert_5Nm" / "m18" / "chain.npz") as z:
         p, chi2, dof = float(z["fit_p"]), float(z["fit_chi2"]), int(z["fit_dof"])
     print(f"verdict: {answer}; chi-square {chi2:.4g} for {dof} dof, p = {p:.2g}; E = {summary['E']:.3g}")
     assert (answer == "Yes") == (p >= P_REJECT and summary["E"] <= HOLDS_E)
