@@ -8,7 +8,7 @@ import pandas as pd
 
 from jointcal.units import G
 
-FN, ZETA, GAIN = 20.0, 0.02, 0.02  # Hz, -, response displacement per volt at zero frequency (in/V)
+FN, ZETA, GAIN = 20.3, 0.02, 0.02  # Hz, -, response displacement per volt at zero frequency (in/V)
 
 
 def linear_frf(f: np.ndarray | float, fn: float = FN, zeta: float = ZETA) -> np.ndarray:
