@@ -1,12 +1,13 @@
 """The manifest's test kinds (jointcal.io._kinds): sweep by default, dwell and ringdown, and their checks."""
 from __future__ import annotations
 
+import numpy as np
 import pandas as pd
 import pytest
 from _campaign import EXAMPLE, example_copy, edit_manifest
 from _kinds_records import dwell_row, kinds_campaign, linear_dwell
 
-from jointcal.io import CampaignError, ingest_campaign, read_manifest
+from jointcal.io import CampaignError, ingest_campaign, read_manifest, read_run
 
 
 def _one_sentence(msg: str, *words: str) -> None:
@@ -93,3 +94,39 @@ def test_sweeps_are_the_default_and_read_as_before(tmp_path, test):
     pd.testing.assert_frame_equal(before, after.drop(columns=["test"], errors="ignore"))
     assert test is None or set(after["test"]) == {"sweep"}
     assert EXAMPLE.is_dir()
+
+
+def _testlab_pair(folder, rid, rec):
+    """A run exported as Test.Lab does it: the response in <rid>_Time.mat, the drive apart in <rid>_TimeShaker.mat."""
+    from test_lab_formats import write_testlab
+
+    folder.mkdir(parents=True, exist_ok=True)
+    write_testlab(folder / f"{rid}_Time.mat", rec[["time_s", "response_accel_g"]], {"response_accel_g": "g"})
+    write_testlab(folder / f"{rid}_TimeShaker.mat", rec[["time_s", "drive_V"]], {"drive_V": "V"})
+
+
+def test_a_drive_exported_apart_is_read_from_reference_file(tmp_path, records):
+    from test_lab_formats import NAMES
+
+    lab = tmp_path / "lab"
+    for rid, rec in (("d18", "d18"), ("d20", "d20"), ("r20", "d20")):
+        _testlab_pair(lab, rid, records[rec])
+    rows = [dwell_row("d18", 18.0, 1), dwell_row("d20", 20.0, 2), dwell_row("r20", 0, 3, test="ringdown")]
+    for r, rid, ref in zip(rows, ("d18", "d20", "r20"), (True, True, False)):  # r20: its drive not recorded
+        r.update(file=f"../lab/{rid}_Time.mat", response_channel=NAMES["response_accel_g"],
+                 reference_channel=NAMES["drive_V"] if ref else "",
+                 reference_file=f"../lab/{rid}_TimeShaker.mat" if ref else "", note="lab export")
+    campaign = kinds_campaign(tmp_path / "c", rows, {})
+    runs = ingest_campaign(campaign).set_index("run_id")
+    plain = ingest_campaign(_campaign(tmp_path, records)).set_index("run_id")
+    for col in ("f_first_hz", "rms_drive_V", "rms_response_accel_g"):  # the dwells as from one CSV file each
+        assert np.allclose(runs[col][:2].to_numpy(float), plain[col][:2].to_numpy(float), rtol=1e-6), col
+    assert runs.loc["r20", "rms_drive_V"] == 0 and np.isclose(runs.loc["r20", "rms_response_accel_g"],
+                                                              plain.loc["r20", "rms_response_accel_g"], rtol=1e-6)
+    assert (runs["flags"] == "").all()
+    rec = read_run(campaign / rows[2]["file"], runs.loc["r20"].to_dict() | {"run_id": "r20"})
+    assert (rec["drive_V"] == 0).all() and rec.attrs["sources"]["drive_V"]["name"] == "not recorded"
+    rows[0]["reference_file"] = "../lab/d19_TimeShaker.mat"
+    with pytest.raises(CampaignError) as info:
+        ingest_campaign(kinds_campaign(tmp_path / "c", rows, {}))
+    _one_sentence(str(info.value), "d19_TimeShaker.mat", "the reference_file of run 'd18'", "does not exist")

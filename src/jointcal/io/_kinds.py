@@ -20,6 +20,7 @@ from jointcal.io._contract import fail
 __all__: list[str] = []
 
 TEST, DWELL = "test", "dwell_hz"  # manifest columns: the run's kind; a dwell's frequency (Hz)
+REF_FILE = "reference_file"  # optional manifest column: the lab export holding the reference, when apart
 SWEEP_ONLY = ("direction", "f_start_hz", "f_stop_hz", "sweep_rate_hz_per_s")
 
 
