@@ -20,9 +20,9 @@ def test_a_linear_modes_dwells_give_its_frf_resonance_and_damping():
         rec = linear_dwell(fs, f, 0.5, 12.0, 3.0, noise=0.01, rng=rng)  # 0.1-0.3% of the response's amplitude
         p = dwell_point(rec["response_accel_g"].to_numpy(), rec["drive_V"].to_numpy(), fs, f)
         assert abs(p["ratio"] / linear_frf(f) - 1) < 1e-3 and p["flags"] == []
-        assert abs(p["ref_amp"] - 0.5) < 1e-6 and abs(p["t1_s"] - 12.0) < 2 / fs  # read up to the cut
+        assert abs(p["ref_amp"] - 0.5) < 1e-6 and 0 <= 12.0 - p["t1_s"] < 1 / f  # read up to the last peak
         pts.append(p)
-    m = dwell_mode([p["f_hz"] for p in pts], [p["ratio"] for p in pts], [p["q_in"] for p in pts])
+    m = dwell_mode([p["f_hz"] for p in pts], [p["X"] for p in pts], [p["q_in"] for p in pts])
     assert abs(m["f_hz"] / FN - 1) < 5e-4 and abs(m["zeta"] / ZETA - 1) < 0.02 and m["flags"] == []
     for q, f_n, z in m["points"]:  # a linear mode: every point its natural frequency and damping
         assert abs(f_n / FN - 1) < 5e-4 and abs(z / ZETA - 1) < 0.02
@@ -38,7 +38,7 @@ def test_a_dwell_whose_transient_has_not_died_out_is_flagged():
 
 
 def test_dwells_on_one_side_of_resonance_say_so():
-    pts = [(f, linear_frf(f), 1.0) for f in (18.0, 18.5, 19.0)]
+    pts = [(f, -linear_frf(f) * G / (2 * np.pi * f) ** 2, 1.0) for f in (18.0, 18.5, 19.0)]  # in per V
     m = dwell_mode(*map(np.array, zip(*pts)))
     assert "no_quadrature" in m["flags"] and abs(m["f_hz"] / FN - 1) < 1e-6  # the nearest point's own wn
 
@@ -63,7 +63,7 @@ def iwan_dwells():
 def test_the_exact_iwan_dwells_read_the_harmonic_balance_at_the_amplitude_reached(iwan_dwells):
     pts = iwan_dwells
     assert all(p["flags"] == [] for p in pts)
-    m = dwell_mode([p["f_hz"] for p in pts], [p["ratio"] for p in pts], [p["q_in"] for p in pts])
+    m = dwell_mode([p["f_hz"] for p in pts], [p["X"] for p in pts], [p["q_in"] for p in pts])
     joint = (JOINT["Fs"], JOINT["KT"], JOINT["chi"], JOINT["beta"], JOINT["k"], JOINT["m"], JOINT["zeta_v"])
     f_t, z_t = harmonic_balance(np.array([m["q_in"]]), *joint)
     assert m["flags"] == [] and 96.6 < m["f_hz"] < 98.2

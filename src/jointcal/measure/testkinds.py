@@ -4,7 +4,7 @@ A sweep run is read by `jointcal.measure.campaign` as before and gives one point
 The runs of the other test kinds (`jointcal.io.test_kind`), in the order data flows:
 
 1. **The mode's frequency**: the largest peak of the response's spectrum over its free decay
-   (a ring-down, or a dwell's ring-down after the cut), else over the dwell; the nearest of
+   (a ring-down, or a dwell's ring-down after the cut), else the dwell's frequency; the nearest of
    ``modal.mode_hz`` when given. Runs are named after the assembly's swept mode within `NEAR` of
    it, else grouped (frequencies within `NEAR`) and named by the lowest level's read-out (its
    largest ring-down window's frequency, else its spectral peak; `jointcal.measure.modes.mode_name`).
@@ -24,6 +24,7 @@ import pandas as pd
 
 from ..io._contract import LEVEL, REFERENCE, RESPONSE
 from ..io._kinds import DWELL
+from ..units import G
 from .dwell import dwell_mode, dwell_point
 from .modes import mode_name
 from .peaks import parabola_vertex
@@ -32,14 +33,22 @@ from .ringdown import decay_start, ringdown_backbone
 __all__ = ["other_kinds_modal", "backbone_table", "BACKBONE_COLUMNS", "MIN_DECAY_S", "NEAR"]
 
 BACKBONE_COLUMNS = ["run_id", "mode", "test", "q_in", "f_hz", "zeta"]
-MIN_DECAY_S = 2.0  # a dwell's record this long after the cut holds a ring-down to read
+MIN_DECAY_S = 1.0  # a dwell's record this long after the cut holds a ring-down to read (as decay_start asks)
 NEAR = 0.1  # relative distance within which two frequencies are one mode
 IDENTITY = ("run_id", "assembly", "sequence", "direction")
 
 
-def _peak_hz(x: np.ndarray, fs: float, lo: float = 0.5) -> float:
-    """The largest spectral peak of `x` above `lo` Hz (Hann window, 8x zero padding, parabola on the log)."""
-    y = (x - x.mean()) * np.hanning(x.size)
+def _peak_hz(x: np.ndarray, fs: float, lo: float = 0.5, decay: bool = False) -> float:
+    """The largest spectral peak of `x` above `lo` Hz (8x zero padding, parabola on the log).
+
+    A decay is cut where it last stands 20x over its tail's median (the noise) and read without a
+    window (it tapers itself); any other record under a Hann window.
+    """
+    if decay:
+        a = np.abs(x - np.median(x))
+        noise = np.median(a[-max(a.size // 10, 1):])
+        x = x[:max(int(np.flatnonzero(a > 20 * noise)[-1]) + 1 if (a > 20 * noise).any() else a.size, 64)]
+    y = (x - x.mean()) * (1.0 if decay else np.hanning(x.size))
     n = 8 * x.size
     mag = np.abs(np.fft.rfft(y, n))
     mag[: int(np.ceil(lo * n / fs)) + 1] = 0.0
@@ -65,15 +74,19 @@ def _read_run(row: dict, record: pd.DataFrame, kind: str, mode_hz) -> dict:
     resp = np.nan_to_num(record[RESPONSE].to_numpy(float))
     ref = np.nan_to_num(record[REFERENCE[kind]].to_numpy(float))
     start = _decay(resp, ref, fs)
-    seg = resp[start:start + int(min(resp.size - start, 10 * fs))] if start is not None else resp[resp.size // 2:]
-    f = _peak_hz(seg, fs)
+    if start is not None:
+        f = _peak_hz(resp[start:], fs, decay=True)
+    elif row.get("test") == "dwell":
+        f = float(row[DWELL])
+    else:
+        f = _peak_hz(resp, fs)
     if mode_hz is not None:
         f = min((float(v) for v in np.atleast_1d(mode_hz)), key=lambda v: abs(v - f))
     out = {"row": row, "f_guess": f, "windows": None, "point": None, "notes": []}
     if start is not None:
         out["windows"] = ringdown_backbone(resp, fs, f, start=start)
     if row.get("test") == "dwell":
-        out["point"] = dwell_point(resp, ref, fs, float(row[DWELL]))
+        out["point"] = dwell_point(resp, ref, fs, float(row[DWELL]), kind)
     return out
 
 
@@ -136,8 +149,8 @@ def other_kinds_modal(rows: list[dict], records: dict, kind: str, swept: dict[st
                 r["dwell"] = {"q_in": r["point"]["q_in"], "f_hz": nan, "zeta": nan,
                               "fit": {"f_hz": nan, "zeta": nan, "q_in": nan, "residual": nan, "flags": ["few_dwells"]}}
             continue
-        fit = dwell_mode(np.array([p["f_hz"] for p in pts]), np.array([p["ratio"] for p in pts]),
-                         np.array([p["q_in"] for p in pts]))
+        fit = dwell_mode(np.array([p["f_hz"] for p in pts]), np.array([p["X"] for p in pts]),
+                         np.array([p["q_in"] for p in pts]), A=-G if kind == "base" else None)
         for r, (q, f, z) in zip(group, fit["points"]):
             r["dwell"] = {"q_in": q, "f_hz": f, "zeta": z, "fit": fit}
     modal, points = [], []
@@ -181,7 +194,8 @@ def backbone_table(modal: pd.DataFrame, points: list[dict]) -> pd.DataFrame:
     The rows flagged ``unusable`` are left out; the order is the modal table's runs, windows in time order.
     """
     usable = ~modal["flags"].fillna("").str.contains("unusable")
-    sweep = modal["f_res_method"].isin(["dwell", "ringdown"]) == False  # noqa: E712
+    method = modal["f_res_method"] if "f_res_method" in modal else pd.Series("", index=modal.index)
+    sweep = ~method.isin(["dwell", "ringdown"])
     rows = modal.loc[usable & sweep]
     out = [pd.DataFrame({"run_id": rows["run_id"], "mode": rows["mode"], "test": "sweep", "q_in": rows["q_in"],
                          "f_hz": rows["f_res_hz"], "zeta": rows["zeta_res"]})]
