@@ -9,6 +9,7 @@ from _kinds_records import FN, ZETA, dwell_row, kinds_campaign, linear_dwell
 
 from jointcal.io import ingest_campaign, read_run
 from jointcal.measure.campaign import campaign_modal
+from jointcal.measure.scatter import scatter
 from jointcal.measure.testkinds import BACKBONE_COLUMNS, backbone_table
 
 FREQS = (19.3, 19.9, 20.2, 20.5, 21.1)
@@ -59,3 +60,10 @@ def test_a_sweep_row_gives_its_one_point():
     bb = backbone_table(modal, [])
     assert bb.to_dict("records") == [{"run_id": "s1", "mode": "m20", "test": "sweep", "q_in": 1e-3, "f_hz": 20.0,
                                       "zeta": 0.02}]
+
+
+def test_dwells_and_ring_downs_are_no_repeats_in_the_scatter(modal):
+    table, _, _ = modal
+    assert len(table) == 6 and set(table["level_V"]) == {0.5}  # six runs at one level, none a repeat
+    sc = scatter(table)
+    assert not (sc["source"] == "repeats").any() and sc["rel_std"].isna().all()
