@@ -129,4 +129,5 @@ def test_a_drive_exported_apart_is_read_from_reference_file(tmp_path, records):
     rows[0]["reference_file"] = "../lab/d19_TimeShaker.mat"
     with pytest.raises(CampaignError) as info:
         ingest_campaign(kinds_campaign(tmp_path / "c", rows, {}))
-    _one_sentence(str(info.value), "d19_TimeShaker.mat", "the reference_file of run 'd18'", "does not exist")
+    _one_sentence(str(info.value), "d19_TimeShaker.mat",
+                  "the reference_file of run 'd18' listed in manifest.csv (line 2) does not exist")

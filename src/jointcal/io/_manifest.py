@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 
 from jointcal.io._contract import LEVEL, POSITIVE, START, TEXT, CampaignWarning, fail
-from jointcal.io._kinds import DWELL, SWEEP_ONLY, TEST, manifest_kind
+from jointcal.io._kinds import DWELL, REF_FILE, SWEEP_ONLY, TEST, manifest_kind
 
 __all__ = ["read_manifest", "check_csv_text"]
 
@@ -197,6 +197,10 @@ def _check_files(df: pd.DataFrame, path: Path, lines: np.ndarray) -> None:
         if not (folder / file).is_file():
             fail(folder / file, f"the file of run {rid!r} listed in manifest.csv (line {lines[i]}) does not exist",
                  "add the file or correct its name in the manifest's file column")
+    for i, (rid, ref) in enumerate(zip(df["run_id"], df.get(REF_FILE, [""] * len(df)))):
+        if ref and not (folder / ref).is_file():
+            fail(folder / ref, f"the reference_file of run {rid!r} listed in manifest.csv (line {lines[i]}) does "
+                 "not exist", "add the file or correct its name in the manifest's reference_file column")
 
 
 def _manifest_row(rec: dict[str, str], path: Path, line: int, level: str) -> dict[str, Any]:
