@@ -12,7 +12,8 @@ FN, ZETA, GAIN = 20.3, 0.02, 0.02  # Hz, -, response displacement per volt at ze
 
 
 def linear_frf(f: np.ndarray | float, fn: float = FN, zeta: float = ZETA) -> np.ndarray:
-    """Closed-form acceleration (g) per drive volt of the linear mode: -w^2 GAIN wn^2 / (wn^2 - w^2 + 2i zeta wn w) / G."""
+    """Closed-form acceleration (g) per drive volt of the linear mode: -w^2 GAIN wn^2 / (wn^2 - w^2 + 2i zeta wn w) / G.
+    """
     w, wn = 2 * np.pi * np.asarray(f, float), 2 * np.pi * fn
     return -w**2 * GAIN * wn**2 / (wn**2 - w**2 + 2j * zeta * wn * w) / G
 

@@ -6,26 +6,29 @@ frequencies give the steady-state FRF near the mode, its phase resonance and its
 
 The read-out, in the order data flows:
 
-1. **The steady part** (`dwell_point`): the drive's held part (up to its last sample within `HELD`
-   of its plateau, the median of its largest sample per period: a ramp-down, a cut and a ring-down
-   may follow), of which the last half is read. Over it the response and the reference are each fitted by least squares as
-   ``c + Re(Z exp(i w t))`` at the dwell frequency over whole cycles (a lock-in: the joint's
-   harmonics are orthogonal to it), giving ``H = Z_resp / Z_ref`` (g per reference unit), the
-   displacement ratio ``X`` (`jointcal.measure.frf.displacement_ratio`: ``-H G / w^2``, base-driven
-   the relative displacement ``-(H - 1) G / w^2``) and the displacement amplitude ``q_in = |X Z_ref|``
-   (in). ``H`` over the read part's first and second halves differs by more than `TRANSIENT` of
-   ``|H|`` where the transient has not died out: flagged ``dwell_transient`` (a ratio, so that a
-   controller's slow amplitude ripple, which moves both channels, is no transient).
-2. **The level's mode** (`dwell_mode`): the points' displacement ratios ``X_i`` are fitted by one mode whose stiffness and damping follow the amplitude reached,
-   ``A / X_i = wn^2(q_i) - w_i^2 + i w_i c(q_i)`` with ``wn^2`` and ``c`` affine in ``q_i`` and a complex
-   modal constant A (linear in the unknowns: Levy's equation-error form of `jointcal.measure.modefit`'s
-   single-mode model; the amplitude terms only with four points or more). Base-driven, A is -G
-   exactly (a single mode's relative displacement per base acceleration) and is not fitted: on the
-   Ministack at 2 g, five dwells across the bent peak fit A 8% off and the points' f by 0.5%. Every point then gives
-   its natural frequency at its amplitude, ``wn_i^2 = w_i^2 + Re(A / X_i)`` (first harmonic balance:
-   exact whatever the frequency of the dwell), and its damping ``zeta_i = Im(A / X_i) / (2 wn_i w_i)``
-   (exact for viscous damping; a joint's hysteresis, rate independent, reads wn_i / w_i of it off
-   resonance).
+1. **The steady part** (`dwell_point`): the drive's held part (up to its last sample within
+   `HELD` of its plateau, the median of its largest sample per period: a ramp-down, a cut and a
+   ring-down may follow), of which the last half is read. Over it the response and the reference
+   are each fitted by least squares as ``c + Re(Z exp(i w t))`` at the dwell frequency over whole
+   cycles (a lock-in: the joint's harmonics are orthogonal to it), giving ``H = Z_resp / Z_ref``
+   (g per reference unit), the displacement ratio ``X`` (`jointcal.measure.frf.displacement_ratio`:
+   ``-H G / w^2``; base-driven the relative displacement, ``-(H - 1) G / w^2``) and the displacement
+   amplitude ``q_in = |X Z_ref|`` (in). ``H`` over the read part's first and second halves differs
+   by more than `TRANSIENT` of ``|H|`` where the transient has not died out: flagged
+   ``dwell_transient`` (a ratio, so that a controller's slow amplitude ripple, which moves both
+   channels, is no transient).
+2. **The level's mode** (`dwell_mode`): the points' displacement ratios ``X_i`` are fitted by one
+   mode whose stiffness and damping follow the amplitude reached,
+   ``A / X_i = wn^2(q_i) - w_i^2 + i w_i c(q_i)``, with ``wn^2`` and ``c`` affine in ``q_i`` and a
+   complex modal constant A (linear in the unknowns: Levy's equation-error form of
+   `jointcal.measure.modefit`'s single-mode model; the amplitude terms only with four points or
+   more). Base-driven, A is -G exactly (a single mode's relative displacement per base
+   acceleration) and is not fitted: on the Ministack at 2 g, five dwells across the bent peak fit
+   A 8% off and the points' f by 0.5%. Every point then gives its natural frequency at its
+   amplitude, ``wn_i^2 = w_i^2 + Re(A / X_i)`` (first harmonic balance: exact whatever the dwell's
+   frequency), and its damping ``zeta_i = Im(A / X_i) / (2 wn_i w_i)`` (exact for viscous damping;
+   a joint's hysteresis, rate independent, reads wn_i / w_i of it off resonance: docs/physics.md
+   section 8).
 3. **Phase resonance** (quadrature): where ``Re(A / X)`` changes sign between two points (the
    response 90 degrees behind the reference, A's own phase removed), by linear interpolation in
    ``w^2``; ``zeta`` and ``q_in`` there likewise. Flagged ``no_quadrature`` when the points do not

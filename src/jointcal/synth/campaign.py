@@ -1,9 +1,9 @@
 """A virtual shaker lab: campaigns in the raw-data contract from a known truth.
 
 `generate(spec, out_dir, truth_path)` simulates every run of the spec's test series
-(sweeps; dwells and ring-downs, `jointcal.synth.steady`) with the exact-Iwan simulator (plus the hidden effect, if any), passes both
-channels through the measurement chain (`jointcal.synth.daq`), and writes the
-campaign (manifest + one file per run) and, separately, the truth: parameters, effect
+(sweeps; dwells and ring-downs, `jointcal.synth.steady`) with the exact-Iwan simulator
+(plus the hidden effect, if any), passes both channels through the measurement chain
+(`jointcal.synth.daq`), and writes the campaign (manifest + one file per run) and, separately, the truth: parameters, effect
 and per run the harmonic-balance steady-state resonance at that level.
 """
 from __future__ import annotations
