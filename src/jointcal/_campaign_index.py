@@ -31,12 +31,16 @@ class CampaignIndex:
     problem : str or None
         `read_manifest`'s one-sentence error when the manifest fails its checks (then the names
         above come from its ``run_id``, ``assembly`` and ``file`` columns alone), else None.
+    reference_files : tuple of str
+        The files the manifest's ``reference_file`` column names (a lab export holding a run's
+        reference apart), joined with the manifest's folder; inputs of the rules that read records.
     """
 
     run_files: dict[str, str]
     run_assembly: dict[str, str]
     excitation: str
     problem: str | None = None
+    reference_files: tuple[str, ...] = ()
 
     @property
     def assemblies(self) -> list[str]:
@@ -90,7 +94,10 @@ def campaign_index(manifest: str | os.PathLike[str]) -> CampaignIndex:
     return CampaignIndex(run_files={r: str(manifest.parent / str(f)) for r, f in zip(ids, files)},
                          run_assembly=dict(zip(ids, (str(a) for a in table["assembly"]))),
                          excitation=excitation_kind(table.columns),
-                         problem=problem)
+                         problem=problem,
+                         reference_files=tuple(str(manifest.parent / str(f)) for f in
+                                               (table["reference_file"] if "reference_file" in table else [])
+                                               if isinstance(f, str) and f.strip()))
 
 
 def unit_table(modal, assembly: str, mode: str):

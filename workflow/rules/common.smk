@@ -106,15 +106,15 @@ def checked_campaign():
 
 
 def campaign_files(wildcards):
-    """The manifest and every run file it lists, once the manifest is checked (checked_campaign)."""
+    """The manifest and every run file it lists (with its reference files), once it is checked (checked_campaign)."""
     checked_campaign()
-    return {"manifest": str(MANIFEST), "runs": list(RUN_FILES.values())}
+    return {"manifest": str(MANIFEST), "runs": list(RUN_FILES.values()) + list(CAMPAIGN.reference_files)}
 
 
 def campaign_records(wildcards):
-    """Every run file the manifest lists, once the manifest is checked."""
+    """Every run file the manifest lists (and the lab exports holding references apart), once it is checked."""
     checked_campaign()
-    return list(RUN_FILES.values())
+    return list(RUN_FILES.values()) + list(CAMPAIGN.reference_files)
 
 
 def run_record(wildcards):

@@ -9,6 +9,7 @@ checkpoint modal_properties:  # its table names the (assembly, mode) units of th
     output:
         table=MODAL / "modal_properties.csv",
         scatter=MODAL / "scatter.csv",
+        backbone=MODAL / "backbone.csv",
         frf=directory(MODAL / "frf"),
     params:
         code=source_hash("modal.py"),

@@ -11,12 +11,16 @@ from pathlib import Path
 
 import pandas as pd
 
-from jointcal.io import listed_record, read_run, write_csv_atomic, write_json_atomic
+from jointcal.io import listed_record, read_run, test_kind, write_csv_atomic, write_json_atomic
 from jointcal.measure.envelopes import ENVELOPE_COLUMNS, envelopes, meta_dict
 
 
 def one_run(path: str, row: dict, settings: dict, env_file: str, meta_file: str) -> str:
     """Write one run's envelopes and metadata; return its log line."""
+    if test_kind(row) != "sweep":  # a dwell or ring-down: read by the modal stage from its record
+        write_csv_atomic(pd.DataFrame(columns=list(ENVELOPE_COLUMNS)), env_file)
+        write_json_atomic({"error": "", "test": test_kind(row)}, meta_file)
+        return f"jointcal: {row['run_id']}: a {test_kind(row)} run, no sweep envelopes"
     try:
         env, meta = envelopes(read_run(path, row), row, **settings)
         meta = {**meta_dict(meta), "error": ""}

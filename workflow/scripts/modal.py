@@ -3,7 +3,8 @@
 Every run gets a row per mode its band holds (`jointcal.measure.campaign`); a run with problems
 gets flags and a one-sentence warning in the log and on stderr, never a silent drop. Each run's
 whole-record FRF (H1, band-averaged H2 and coherence, the fitted displacement ratio per mode;
-`jointcal.measure.frf`) goes to ``frf/<run_id>.csv``. (No ``from __future__``: see envelopes.py.)
+`jointcal.measure.frf`) goes to ``frf/<run_id>.csv``. Every run's amplitude-dependent points, from
+every test kind, go to ``backbone.csv`` (`jointcal.measure.testkinds`). (No ``from __future__``: see envelopes.py.)
 """
 import json
 import sys
@@ -16,6 +17,7 @@ from jointcal.measure.campaign import campaign_modal
 from jointcal.measure.flags import run_flags
 from jointcal.measure.frf import frf_table
 from jointcal.measure.scatter import scatter
+from jointcal.measure.testkinds import backbone_table
 
 
 def main(smk) -> None:
@@ -31,7 +33,8 @@ def main(smk) -> None:
         return (pd.read_csv(env_dir / f"{rid}.csv"), json.loads((env_dir / f"{rid}.json").read_text()),
                 read_run(path, row) if path else None)
 
-    rows, frf, notes = campaign_modal(runs, load, smk.params.modal)
+    points = []
+    rows, frf, notes = campaign_modal(runs, load, smk.params.modal, points=points)
     ingest_flags = dict(zip(runs["run_id"], runs["flags"]))
     for out in rows:
         out["flags"], flag_notes = run_flags(ingest_flags.get(out["run_id"]), out["flags"], out["run_id"],
@@ -43,6 +46,7 @@ def main(smk) -> None:
     table.insert(2, "mode", table.pop("mode"))
     write_csv_atomic(table, smk.output.table)
     write_csv_atomic(scatter(table), smk.output.scatter)
+    write_csv_atomic(backbone_table(table, points), smk.output.backbone)
     lines = [f"jointcal: warning: {n}" for n in notes]
     for line in lines:
         print(line, file=sys.stderr)

@@ -1,6 +1,6 @@
 """The drive's frequency at a record's start and end, checked against the manifest's band.
 
-Private: `jointcal.io._checks.validate_run` calls `drive_band` and `check_head`.
+Private: `jointcal.io._checks.validate_run` calls `drive_band` and `check_head` (a sweep), `dwell_band` (a dwell).
 """
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from numpy.typing import NDArray
 from jointcal.io._contract import MIN_CYCLES, fail
 from jointcal.measure.peaks import parabola_vertex
 
-__all__ = ["peak_frequency", "drive_band", "check_head"]
+__all__ = ["peak_frequency", "drive_band", "check_head", "dwell_band"]
 
 HEAD_LEVEL = 0.1  # a head quieter than this fraction of the reference's amplitude is silent
 
@@ -91,3 +91,49 @@ def drive_band(ref: NDArray[np.float64], fs: float, f0: float, f1: float,
     f_first = peak_frequency(ref[:nw], fs) - sign * rate * centre_first
     f_last = peak_frequency(ref[i_end - nw:i_end], fs) + sign * rate * (sweep_s - centre_last)
     return f_first, f_last, tol
+
+
+DRIVE_OFF = 0.02  # a drive below this share of its largest value is cut off (as measure.ringdown.DRIVE_OFF)
+TINY = 1e-9  # a dwell is checked as a sweep over this relative band: the sweep's windows, one frequency
+
+
+def dwell_band(drive: NDArray[np.float64], fs: float, f_d: float, path: object,
+               run: str) -> tuple[float, float, float, float]:
+    """A dwell's drive checked against ``dwell_hz``, and the equivalent sweep its amplitude checks use.
+
+    Parameters
+    ----------
+    drive : ndarray of float, shape (n,)
+        The reference channel (any unit); after the dwell it may be cut to zero (a ring-down follows).
+    fs, f_d : float
+        Sample rate and the manifest's ``dwell_hz`` (Hz).
+    path, run : object, str
+        Named in messages.
+
+    Returns
+    -------
+    f0, f1, rate : float
+        A linear sweep from `f_d` over ``TINY`` of it that lasts as long as the drive (Hz, Hz, Hz/s):
+        the sweep checks' windows of ``MIN_CYCLES`` drive cycles, over the dwell only.
+    f_meas : float
+        The drive's frequency over the second half of the dwell (Hz).
+
+    Raises
+    ------
+    CampaignError
+        A drive shorter than ``2 MIN_CYCLES`` cycles, or its frequency off `f_d` by more than one
+        FFT bin of the half plus 0.1 %.
+    """
+    x = np.nan_to_num(np.asarray(drive, float) - np.nanmedian(drive))
+    on = np.flatnonzero(np.abs(x) > DRIVE_OFF * np.max(np.abs(x))) if x.size else np.empty(0, int)
+    end = int(on[-1]) + 1 if on.size else x.size
+    if end / fs * f_d < 2 * MIN_CYCLES:
+        fail(path, f"the drive of dwell run {run} lasts {end / fs:.3g} s, fewer than {2 * MIN_CYCLES} cycles at "
+             f"dwell_hz = {f_d:g} Hz", f"record a longer dwell or correct dwell_hz of run {run}")
+    half = x[end // 2:end]
+    got = peak_frequency(half, fs)
+    tol = fs / half.size + 1e-3 * f_d
+    if abs(got - f_d) > tol:
+        fail(path, f"the drive's frequency over the dwell is {got:.4g} Hz, not dwell_hz = {f_d:g} Hz "
+             f"(+/- {tol:.2g} Hz) for run {run}", f"correct dwell_hz of run {run} in manifest.csv")
+    return f_d, f_d * (1 + TINY), f_d * TINY / (end / fs), got

@@ -15,13 +15,14 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from jointcal.io._amplitudes import level_problems, swap_problem, window_amplitudes
-from jointcal.io._band import check_head, drive_band
+from jointcal.io._band import check_head, drive_band, dwell_band
 from jointcal.io._clipping import clip_levels, clipped_mask
 from jointcal.io._dead import dead_problem
 from jointcal.io._contract import (
     LEVEL, REFERENCE, RESPONSE, TIME, CampaignError, CampaignWarning, OnDataProblem,
     excitation_kind, excitation_of, fail,
 )
+from jointcal.io._kinds import DWELL, kind_of
 from jointcal.io._time import check_time, time_resolution
 
 __all__ = ["validate_run", "clipped_mask", "clip_levels", "window_amplitudes", "time_resolution", "UNUSABLE_FLAGS"]
@@ -114,8 +115,17 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
     t = df[TIME].to_numpy(np.float64)
     ref = REFERENCE[kind]
     chans = {c: df[c].to_numpy(np.float64) for c in (ref, RESPONSE)}
-    f0, f1, rate = float(row["f_start_hz"]), float(row["f_stop_hz"]), float(row["sweep_rate_hz_per_s"])
     fs = check_time(t, float(row["sample_rate_hz"]), path, run)
+    test = kind_of(row)
+    if test == "ringdown":
+        return _ringdown_checks(t, chans, fs, kind, clip_run, path, run, on_data_problem)
+    if test == "dwell":  # its amplitude checks over the dwell, as over a sweep of one frequency
+        live = chans[ref][np.isfinite(chans[ref])]
+        f0, f1, rate, f_meas = (dwell_band(chans[ref], fs, float(row[DWELL]), path, run)
+                                if live.size and live.min() < live.max() else (float(row[DWELL]),) * 2 + (1.0, np.nan))
+        row = {**row, "f_start_hz": f0, "f_stop_hz": f1, "sweep_rate_hz_per_s": rate}
+    else:
+        f0, f1, rate = float(row["f_start_hz"]), float(row["f_stop_hz"]), float(row["sweep_rate_hz_per_s"])
     sweep_s = abs(f1 - f0) / rate
     band = f"{f0:g} -> {f1:g} Hz at {rate:g} Hz/s"
     if t.size / fs < 0.95 * sweep_s:
@@ -133,6 +143,9 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
     drive = chans[RESPONSE if swapped else ref]
     if ref in silent:  # no drive to measure: the flag says why, not a misleading band error
         f_first = f_last = tol = float("nan")
+    elif test == "dwell":
+        f_first = f_last = f_meas
+        tol = fs * 2 / t.size + 1e-3 * f0
     else:
         f_first, f_last, tol = drive_band(drive, fs, f0, f1, rate)
     for label, got, exp in (("start", f_first, f0), ("end", f_last, f1)):
@@ -157,6 +170,22 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
     return {"n_samples": t.size, "duration_s": t.size / fs, "fs_measured_hz": fs, "excitation": kind, **rms,
             "f_first_hz": f_first, "f_last_hz": f_last, "f_tolerance_hz": tol, "response_units_check": units_note,
             "flags": flags}
+
+
+def _ringdown_checks(t: NDArray[np.float64], chans: dict[str, NDArray[np.float64]], fs: float, kind: str,
+                     clip_run: int, path: object, run: str, on_data_problem: OnDataProblem) -> dict[str, Any]:
+    """A ring-down's checks: its channels' data problems (a reference cut to zero or an impact's short
+    pulse is no problem: only its NaN/inf values count); no band, level or drive-following checks."""
+    flags: list[str] = []
+    problems = _data_problems(t, chans, clip_run, path, run)
+    _report([p for p in problems if p[0].endswith(RESPONSE) or p[0].startswith("nonfinite")], flags, on_data_problem)
+    rms = {f"rms_{c}": float("nan") for c in (*REFERENCE.values(), RESPONSE)}
+    rms.update({f"rms_{c}": float(np.sqrt(np.mean(x[np.isfinite(x)] ** 2))) for c, x in chans.items()
+                if np.isfinite(x).any()})
+    nan = float("nan")
+    return {"n_samples": t.size, "duration_s": t.size / fs, "fs_measured_hz": fs, "excitation": kind, **rms,
+            "f_first_hz": nan, "f_last_hz": nan, "f_tolerance_hz": nan,
+            "response_units_check": "not checkable: a ring-down holds no drive over a band", "flags": flags}
 
 
 def _data_problems(t: NDArray[np.float64], chans: dict[str, NDArray[np.float64]], clip_run: int,

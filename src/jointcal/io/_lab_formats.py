@@ -56,7 +56,8 @@ def is_testlab(mat: Mapping[str, Any]) -> bool:
 
 
 def read_lab_export(path: Path, kind: Excitation | None, channels: Mapping[str, str | None],
-                    run_id: str | None) -> tuple[dict[str, NDArray[np.float64]], dict[str, Any]]:
+                    run_id: str | None, *, reference_path: Path | None = None,
+                    no_reference: bool = False) -> tuple[dict[str, NDArray[np.float64]], dict[str, Any]]:
     """The contract's three columns from a lab export, with their sources (see `jointcal.io.read_run`).
 
     Parameters
@@ -69,6 +70,12 @@ def read_lab_export(path: Path, kind: Excitation | None, channels: Mapping[str, 
         ``{'reference': name, 'response': name}`` from the manifest row.
     run_id : str or None
         The run, named in messages.
+    reference_path : Path, optional
+        The lab's export that holds the reference channel, when not `path` (the manifest's
+        ``reference_file``: Test.Lab exports the drive of a run apart, ``*_TimeShaker.mat``).
+    no_reference : bool, optional
+        True for a ring-down whose drive was not recorded (its ``reference_channel`` empty): the
+        reference column is then zero throughout, its source 'not recorded'.
     """
     fmt = FORMATS[path.suffix.lower()]
     if kind is None:
@@ -77,23 +84,30 @@ def read_lab_export(path: Path, kind: Excitation | None, channels: Mapping[str, 
     found = lab_channels(path, fmt)
     listed = ", ".join(repr(c.names[0]) for c in found) or "none"
     run = f" of run {run_id!r}" if run_id else ""
-    picked = {}
+    ref_found = lab_channels(reference_path, FORMATS[reference_path.suffix.lower()]) if reference_path else found
+    files = {"reference": (reference_path or path, ref_found), "response": (path, found)}
+    picked, where = {}, {}
     for role, column in (("reference", REFERENCE[kind]), ("response", RESPONSE)):
         want = channels.get(role)
+        if role == "reference" and no_reference and not want:
+            continue
+        file, chans = files[role]
+        listed = ", ".join(repr(c.names[0]) for c in chans) or "none"
         if not want:
-            fail(path, f"a {fmt} file names its channels, and the manifest's {CHANNEL_COLUMNS[role]}{run} is empty "
+            fail(file, f"a {fmt} file names its channels, and the manifest's {CHANNEL_COLUMNS[role]}{run} is empty "
                  f"(the file's channels: {listed})", f"write the {role} channel's name there")
-        hits = [c for c in found if want in c.names] or [c for c in found
+        hits = [c for c in chans if want in c.names] or [c for c in chans
                                                         if want.lower() in (n.lower() for n in c.names)]
         if not hits:
-            fail(path, f"it has no channel {want!r} (named in {CHANNEL_COLUMNS[role]}{run}); the file's channels are "
+            fail(file, f"it has no channel {want!r} (named in {CHANNEL_COLUMNS[role]}{run}); the file's channels are "
                  f"{listed}", f"write one of them in {CHANNEL_COLUMNS[role]}")
         if len(hits) > 1:
-            fail(path, f"{want!r} ({CHANNEL_COLUMNS[role]}{run}) names {len(hits)} channels "
+            fail(file, f"{want!r} ({CHANNEL_COLUMNS[role]}{run}) names {len(hits)} channels "
                  f"({', '.join(repr(c.names[-1]) for c in hits)})", "write the full name (e.g. group/channel)")
-        picked[column] = hits[0]
-    ref, resp = picked[REFERENCE[kind]], picked[RESPONSE]
-    if ref is resp:
+        picked[column], where[column] = hits[0], (file, listed)
+    resp = picked[RESPONSE]
+    ref = picked.get(REFERENCE[kind], resp)
+    if REFERENCE[kind] in picked and ref is resp:
         fail(path, f"reference_channel and response_channel{run} name one channel {ref.names[0]!r}",
              "name the reference (drive) and the response channels")
     if ref.values.size != resp.values.size or abs(ref.dt / resp.dt - 1) > 1e-9 or abs(ref.t0 - resp.t0) > ref.dt / 2:
@@ -102,9 +116,12 @@ def read_lab_export(path: Path, kind: Excitation | None, channels: Mapping[str, 
              f"{resp.t0:g} s)", "export both channels of the run from one acquisition")
     cols = {TIME: ref.t0 + ref.dt * np.arange(ref.values.size)}
     sources = {TIME: {"name": "the file's time axis", "unit": "s", "by": "file"}}
+    if REFERENCE[kind] not in picked:  # a ring-down whose drive was not recorded
+        cols[REFERENCE[kind]] = np.zeros(resp.values.size)
+        sources[REFERENCE[kind]] = {"name": "not recorded", "unit": next(iter(UNITS[QUANTITY[kind]])), "by": "none"}
     for column, ch in picked.items():
         quantity = QUANTITY[kind] if column != RESPONSE else "acceleration"
-        cols[column], sources[column] = _in_contract_unit(ch, quantity, column, path, listed)
+        cols[column], sources[column] = _in_contract_unit(ch, quantity, column, where[column][0], where[column][1])
     return cols, {"format": fmt, "sources": sources}
 
 

@@ -16,6 +16,7 @@ import numpy as np
 import pandas as pd
 
 from jointcal.io._contract import LEVEL, POSITIVE, START, TEXT, CampaignWarning, fail
+from jointcal.io._kinds import DWELL, REF_FILE, SWEEP_ONLY, TEST, manifest_kind
 
 __all__ = ["read_manifest", "check_csv_text"]
 
@@ -39,20 +40,27 @@ def read_manifest(path: str | os.PathLike[str]) -> pd.DataFrame:
         to the manifest's folder, written with '/'). Optional: ``sweep_start_s`` (s,
         the sweep's start after the record's first sample; empty or 0 when the record
         starts with the sweep), ``reference_channel`` and ``response_channel`` (the
-        channel names in a lab format's file). Extra columns are kept.
+        channel names in a lab format's file), ``test`` (the run's kind: ``sweep``,
+        the default when the column is absent or the cell empty, ``dwell`` or ``ringdown``;
+        `jointcal.io._kinds`) and ``dwell_hz`` (Hz, a dwell's drive frequency). A run of
+        another kind than ``sweep`` may leave ``direction``, ``f_start_hz``, ``f_stop_hz``
+        and ``sweep_rate_hz_per_s`` empty, and a campaign without sweeps may leave those
+        columns out. Extra columns are kept.
 
     Returns
     -------
     pandas.DataFrame
         One row per run in file order; numbers as float64 (``sequence`` int64),
-        text stripped, ``direction`` lower-case. Rows whose every cell is empty
+        text stripped, ``direction`` and ``test`` lower-case (``test`` empty -> ``sweep``),
+        a sweep column a run does not need NaN when empty. Rows whose every cell is empty
         (a spreadsheet's trailing rows) are left out with a `CampaignWarning`.
 
     Raises
     ------
     CampaignError
         Missing file or column, a file that is not comma-separated text, empty or
-        non-numeric cell, non-positive rate or frequency, band inconsistent with the
+        non-numeric cell, non-positive rate or frequency, a ``test`` that is no kind,
+        a dwell without ``dwell_hz`` or with it above Nyquist, band inconsistent with the
         direction or above Nyquist, a duplicated ``run_id`` or (``assembly``,
         ``sequence``), one record listed twice (under any spelling), a ``file``
         written with a Windows backslash, or a listed file that does not exist.
@@ -72,10 +80,16 @@ def read_manifest(path: str | os.PathLike[str]) -> pd.DataFrame:
         fail(path, f"it needs exactly one of the columns {', '.join(LEVEL.values())} (found {found})",
              "give level_g for base-driven, level_lbf for force-driven or level_V for voltage-driven campaigns")
     need = ["run_id", "assembly", "sequence", levels[0], "direction", *POSITIVE, "file"]
-    missing = [c for c in need if c not in raw.columns]
+    kinds = raw[TEST].str.strip().str.lower() if TEST in raw.columns else pd.Series("", index=raw.index)
+    header = [c for c in need if c not in SWEEP_ONLY or kinds.isin(["", "sweep"]).any()]
+    header += [DWELL] if (kinds == "dwell").any() else []
+    missing = [c for c in header if c not in raw.columns]
     if missing:
         fail(path, f"column(s) {', '.join(missing)} missing (found: {', '.join(raw.columns)})",
-             f"use the header {','.join(need)}")
+             f"use the header {','.join(header)}")
+    for col in need:
+        if col not in raw.columns:  # a sweep column of a campaign without sweeps: empty
+            raw[col] = ""
     empty = (raw.apply(lambda c: c.str.strip()) == "").all(axis=1).to_numpy()
     if empty.any():
         lines = _ranges(np.flatnonzero(empty) + 2)
@@ -183,14 +197,23 @@ def _check_files(df: pd.DataFrame, path: Path, lines: np.ndarray) -> None:
         if not (folder / file).is_file():
             fail(folder / file, f"the file of run {rid!r} listed in manifest.csv (line {lines[i]}) does not exist",
                  "add the file or correct its name in the manifest's file column")
+    for i, (rid, ref) in enumerate(zip(df["run_id"], df.get(REF_FILE, [""] * len(df)))):
+        if ref and not (folder / ref).is_file():
+            fail(folder / ref, f"the reference_file of run {rid!r} listed in manifest.csv (line {lines[i]}) does "
+                 "not exist", "add the file or correct its name in the manifest's reference_file column")
 
 
 def _manifest_row(rec: dict[str, str], path: Path, line: int, level: str) -> dict[str, Any]:
     where = f"{path}: line {line} (run_id {rec['run_id'].strip()!r})"
     out: dict[str, Any] = {k: v.strip() for k, v in rec.items()}
-    for col in (*TEXT, "sequence", level, *POSITIVE):
-        if not out[col]:
-            fail(where, f"{col} is empty", f"fill in {col}")
+    kind = manifest_kind(rec, where)
+    if TEST in out:
+        out[TEST] = kind.name
+    needed = [c for c in (*TEXT, "sequence", level, *POSITIVE) if c not in SWEEP_ONLY] + list(kind.needs)
+    for col in needed:
+        if not out.get(col, ""):
+            what = "" if kind.name == "sweep" else f" (a {kind.name} run needs it)"
+            fail(where, f"{col} is empty{what}", f"fill in {col}")
     try:
         out["sequence"] = int(out["sequence"])
     except ValueError:
@@ -198,13 +221,34 @@ def _manifest_row(rec: dict[str, str], path: Path, line: int, level: str) -> dic
     if out["sequence"] < 1:
         fail(where, f"sequence {rec['sequence'].strip()!r} is not an integer >= 1",
              "number the runs of each assembly 1, 2, 3, ... in test order")
-    for col in (level, *POSITIVE):
+    for col in (level, *POSITIVE, DWELL):
+        if col not in out or (col not in needed and not out[col]):
+            if col in out or col in POSITIVE:
+                out[col] = float("nan")  # a column this kind does not need, left empty
+            continue
         try:
             out[col] = float(out[col])
         except ValueError:
             out[col] = float("nan")
         if not (np.isfinite(out[col]) and out[col] > 0):
             fail(where, f"{col} {rec[col].strip()!r} is not a positive number", f"write {col} as a number > 0")
+    if kind.name != "sweep":
+        return _other_kind_row(out, where, kind.name)
+    return _sweep_row(out, rec, where)
+
+
+def _other_kind_row(out: dict[str, Any], where: str, kind: str) -> dict[str, Any]:
+    """A dwell's or ring-down's row: its frequency below Nyquist; the sweep's words left as given."""
+    out["direction"] = out["direction"].lower()
+    fs = out["sample_rate_hz"]
+    if kind == "dwell" and out[DWELL] >= fs / 2:
+        fail(where, f"dwell_hz {out[DWELL]:g} Hz is above Nyquist ({fs / 2:g} Hz)",
+             "check dwell_hz and sample_rate_hz")
+    return out
+
+
+def _sweep_row(out: dict[str, Any], rec: dict[str, str], where: str) -> dict[str, Any]:
+    """A sweep's row: its start, direction and band checked (the contract before test kinds)."""
     if START in out:
         text = out[START]
         try:

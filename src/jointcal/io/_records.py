@@ -19,6 +19,7 @@ from jointcal.io._contract import (
     CHANNEL_COLUMNS, LEVEL, REFERENCE, RESPONSE, RESPONSE_SI, START, TIME, Excitation, OnDataProblem,
     excitation_kind, excitation_of, fail,
 )
+from jointcal.io._kinds import REF_FILE, kind_of
 from jointcal.io._lab_formats import LAB_SUFFIXES, is_testlab, read_lab_export
 from jointcal.io._manifest import check_csv_text, read_manifest
 from jointcal.units import G_SI
@@ -44,7 +45,10 @@ def read_run(path: str | os.PathLike[str], row: Mapping[str, Any] | None = None)
         The run's manifest row (`read_manifest`; a row of runs.csv will do). Its level
         column gives the excitation; its ``sweep_start_s`` (s) drops the samples before
         the sweep; its ``reference_channel`` and ``response_channel`` name a lab
-        export's channels (required for those formats).
+        export's channels (required for those formats), its ``reference_file`` the lab
+        export holding the reference when the lab exported it apart (relative to the
+        manifest's folder); a ``ringdown`` whose drive was not recorded leaves
+        ``reference_channel`` empty (its reference column is then zero).
 
     Returns
     -------
@@ -67,15 +71,19 @@ def read_run(path: str | os.PathLike[str], row: Mapping[str, Any] | None = None)
     name = path.name.lower()
     kind = _row_excitation(row)
     channels = {role: _cell(row, col) for role, col in CHANNEL_COLUMNS.items()} if row is not None else {}
+    lab = {"reference_path": _reference_path(path, row), "no_reference": row is not None and kind_of(row) == "ringdown"}
     if name.endswith(".mat"):
-        cols, attrs = _read_mat(path, kind, channels, row)
+        cols, attrs = _read_mat(path, kind, channels, row, lab)
     elif name.endswith((".csv", ".csv.gz")):
         cols, attrs = _read_csv(path, kind)
     elif name.endswith(LAB_SUFFIXES):
-        cols, attrs = read_lab_export(path, kind, channels, _cell(row, "run_id"))
+        cols, attrs = read_lab_export(path, kind, channels, _cell(row, "run_id"), **lab)
     else:
         fail(path, "unsupported file type",
              f"store runs as .csv, .csv.gz or .mat, or as a lab export ({', '.join(LAB_SUFFIXES)})")
+    if lab["reference_path"] and attrs["format"] in ("CSV", "MAT"):
+        fail(path, f"the manifest names a reference_file ({_cell(row, REF_FILE)}) for a {attrs['format']} record, "
+             "which holds its reference itself", "leave reference_file empty for this run")
     if any(channels.values()) and attrs["format"] in ("CSV", "MAT"):
         fail(path, f"the manifest names channels ({', '.join(c for c in channels.values() if c)}) for a "
              f"{attrs['format']} record, whose {'column' if attrs['format'] == 'CSV' else 'variable'} names are "
@@ -92,6 +100,19 @@ def _cell(row: Mapping[str, Any] | None, col: str) -> str | None:
         value = str(int(value))
     return None if value is None or (isinstance(value, float) and np.isnan(value)) or not str(value).strip() \
         else str(value).strip()
+
+
+def _reference_path(path: Path, row: Mapping[str, Any] | None) -> Path | None:
+    """The file the row's ``reference_file`` names (relative to the manifest's folder, as ``file``), or None."""
+    ref, file = _cell(row, REF_FILE), _cell(row, "file")
+    if ref is None:
+        return None
+    folder = path.parents[len(Path(file).parts) - 1] if file and str(path).endswith(Path(file).name) else path.parent
+    ref_path = folder / ref
+    if not ref_path.is_file():
+        fail(ref_path, f"the reference_file of run {_cell(row, 'run_id')!r} listed in manifest.csv does not exist",
+             "add the file or correct its name in the manifest's reference_file column")
+    return ref_path
 
 
 def _row_excitation(row: Mapping[str, Any] | None) -> Excitation | None:
@@ -151,7 +172,7 @@ def _in_g(cols: dict[str, NDArray[np.float64]], fmt: str) -> tuple[dict[str, NDA
 
 
 def _read_mat(path: Path, kind: Excitation | None, channels: dict[str, str | None],
-              row: Mapping[str, Any] | None) -> tuple[dict[str, NDArray[np.float64]], dict[str, Any]]:
+              row: Mapping[str, Any] | None, lab: dict) -> tuple[dict[str, NDArray[np.float64]], dict[str, Any]]:
     try:
         mat = scipy.io.loadmat(path)
     except NotImplementedError:
@@ -163,7 +184,7 @@ def _read_mat(path: Path, kind: Excitation | None, channels: dict[str, str | Non
         fail(path, f"cannot be read as a MATLAB file ({exc})", "save it with MATLAB's save(..., '-v7')")
     names = [k for k in mat if not k.startswith("__")]
     if is_testlab(mat):
-        return read_lab_export(path, kind, channels, _cell(row, "run_id"))
+        return read_lab_export(path, kind, channels, _cell(row, "run_id"), **lab)
     kind = excitation_of(names, path, expected=kind, noun="variable", others_ok=True)
     out = {}
     for var in (TIME, REFERENCE[kind], _response_name(names)):

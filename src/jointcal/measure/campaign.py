@@ -10,6 +10,10 @@ The modal stage's steps in the order data flows, on the runs of ``runs.csv``:
    started at the run's own peak of that mode), one row per (run, mode) with the mode in the
    ``mode`` column.
 
+A dwell or ring-down run (``test`` in runs.csv) is read by `jointcal.measure.testkinds`, after
+the sweeps, named after its assembly's swept modes; its amplitude-dependent points are appended to
+`points` (backbone.csv).
+
 A base-driven run (the Ministack: one mode in its band) is read as before, at its envelope
 peak (or at each ``modal.mode_hz``), and its mode is named from the read-out at the
 assembly's lowest level. So is every run of an assembly in which no resonance passes the
@@ -24,10 +28,12 @@ import numpy as np
 import pandas as pd
 
 from ..io._contract import LEVEL, REFERENCE, RESPONSE, excitation_kind
+from ..io._kinds import kind_of
 from .envelopes import ENVELOPE_COLUMNS
 from .frf import displacement_ratio, h1_estimate
 from .modal import modal_properties
 from .modes import mode_name, modal_peaks, track_modes
+from .testkinds import other_kinds_modal
 
 __all__ = ["campaign_modal", "run_peaks"]
 
@@ -68,7 +74,8 @@ def _plan(rows: list[dict], records: dict, kind: str, mode_hz) -> list[tuple[dic
     return [(r, g, None) for g in (given or [None]) for r in rows]
 
 
-def campaign_modal(runs: pd.DataFrame, load: Callable[[dict], tuple], modal_kw: dict | None = None):
+def campaign_modal(runs: pd.DataFrame, load: Callable[[dict], tuple], modal_kw: dict | None = None,
+                   points: list | None = None):
     """Every run read at every mode its band holds.
 
     Parameters
@@ -80,6 +87,9 @@ def campaign_modal(runs: pd.DataFrame, load: Callable[[dict], tuple], modal_kw: 
         ``rate_hz_per_s``, ``window_s``, ``error``) and its raw record (DataFrame or None).
     modal_kw : dict, optional
         The config's ``modal`` section (`modal_properties`' keywords; ``mode_hz`` a number, a list or None).
+    points : list, optional
+        Where the dwell and ring-down runs' backbone points go (`jointcal.measure.testkinds`; rows of
+        ``run_id, mode, test, q_in, f_hz, zeta``); None drops them.
 
     Returns
     -------
@@ -95,8 +105,11 @@ def campaign_modal(runs: pd.DataFrame, load: Callable[[dict], tuple], modal_kw: 
     """
     kw = dict(modal_kw or {})
     mode_hz = kw.pop("mode_hz", None)
-    loaded, rows, frf, notes = {}, [], {}, []
+    loaded, rows, frf, notes, others = {}, [], {}, [], []
     for row in runs.to_dict("records"):
+        if kind_of(row) != "sweep":
+            others.append(row)
+            continue
         env, meta, record = load(row)
         if meta.get("error") and record is None:
             rows.append({**{k: row.get(k) for k in IDENTITY}, "mode": "", "flags": "unusable"})
@@ -106,7 +119,8 @@ def campaign_modal(runs: pd.DataFrame, load: Callable[[dict], tuple], modal_kw: 
             env = pd.DataFrame(columns=list(ENVELOPE_COLUMNS))
             notes.append(f"{row['run_id']}: {meta['error']} (the resonance comes from the whole-record FRF)")
         loaded[row["run_id"]] = (row, env, meta, record)
-    for _, group in pd.DataFrame([v[0] for v in loaded.values()] or [{}]).groupby("assembly", sort=False):
+    sweeps = pd.DataFrame([v[0] for v in loaded.values()] or [{"assembly": None}])
+    for _, group in sweeps.dropna(subset=["assembly"]).groupby("assembly", sort=False):
         grows = group.to_dict("records")
         first = loaded[grows[0]["run_id"]]
         kind = excitation_kind([*(first[3].columns if first[3] is not None else []), *first[0]])
@@ -128,9 +142,29 @@ def campaign_modal(runs: pd.DataFrame, load: Callable[[dict], tuple], modal_kw: 
             if len(tab):
                 frf.setdefault(out["run_id"], []).append(_independent_lines(tab, loaded[out["run_id"]]).assign(
                     mode=out["mode"]))
+    _other_kinds(others, rows, load, mode_hz, points)
     order = {r: i for i, r in enumerate(runs["run_id"])}
     rows.sort(key=lambda o: order.get(o["run_id"], -1))
     return rows, {r: pd.concat(t, ignore_index=True) for r, t in frf.items()}, notes
+
+
+def _other_kinds(others: list[dict], rows: list[dict], load: Callable, mode_hz, points: list | None) -> None:
+    """Append the dwell and ring-down runs' modal rows to `rows` and their backbone points to `points`."""
+    for assembly, group in pd.DataFrame(others or [{"assembly": None}]).dropna(subset=["assembly"]).groupby(
+            "assembly", sort=False):
+        grows = group.to_dict("records")
+        records = {r["run_id"]: load(r)[2] for r in grows}
+        first = next((v for v in records.values() if v is not None), None)
+        kind = excitation_kind([*(first.columns if first is not None else []), *grows[0]])
+        mine = [r for r in rows if r.get("assembly") == assembly and "unusable" not in str(r.get("flags", ""))]
+        swept = {}
+        for r in sorted(mine, key=lambda r: r.get(LEVEL[kind], np.inf)):
+            if r.get("mode") and np.isfinite(r.get("f_res_hz", np.nan)):
+                swept.setdefault(r["mode"], float(r["f_res_hz"]))
+        modal, pts = other_kinds_modal(grows, records, kind, swept, mode_hz)
+        rows += modal
+        if points is not None:
+            points += pts
 
 
 def _independent_lines(tab: pd.DataFrame, loaded: tuple) -> pd.DataFrame:

@@ -16,10 +16,14 @@ def scatter(table: pd.DataFrame) -> pd.DataFrame:
     Rows (assembly[, mode], quantity, level, source): 'repeats' for a level run more than twice,
     'up_down' for a level with one up/down pair, and one 'pooled' row per (assembly,
     quantity) with the dof-weighted pooled relative standard deviation (level NaN).
-    Rows flagged unusable are left out.
+    Rows flagged unusable are left out, and so are dwell and ring-down rows (``f_res_method``
+    ``dwell`` or ``ringdown``): a level's dwells are at different frequencies and amplitudes, and a
+    ring-down's row is its own largest window, none a repeat of another.
     """
     level = level_column(table.columns) or "level_g"
     ok = ~table["flags"].fillna("").str.contains("unusable")
+    if "f_res_method" in table.columns:
+        ok &= ~table["f_res_method"].isin(["dwell", "ringdown"])
     keys = ["assembly", "mode"] if "mode" in table.columns else ["assembly"]
     rows = []
     for key, grp in table[ok].groupby(keys, sort=False):

@@ -51,6 +51,13 @@ def plot_envelopes(table: pd.DataFrame, envs: dict[str, pd.DataFrame], path, ram
     level = level_column(table.columns) or "level_g"
     unit = level.split("_")[1]
     asms = list(dict.fromkeys(table["assembly"]))
+    if not asms:  # a campaign without sweeps (dwells, ring-downs): no envelope to show
+        fig, ax = plt.subplots(figsize=(5.5, 4.0))
+        ax.text(0.5, 0.5, "no sweep run: no envelopes", ha="center", va="center", transform=ax.transAxes)
+        ax.set_axis_off()
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+        return
     fig, axes = plt.subplots(1, len(asms), figsize=(5.5 * len(asms), 4.0), squeeze=False, sharey=True)
     for ax, asm in zip(axes[0], asms):
         t = table[table["assembly"] == asm].sort_values("sequence")

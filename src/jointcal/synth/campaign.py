@@ -1,9 +1,9 @@
 """A virtual shaker lab: campaigns in the raw-data contract from a known truth.
 
 `generate(spec, out_dir, truth_path)` simulates every run of the spec's test series
-with the exact-Iwan swept-sine simulator (plus the hidden effect, if any), passes both
-channels through the measurement chain (`jointcal.synth.daq`), and writes the
-campaign (manifest + one file per run) and, separately, the truth: parameters, effect
+(sweeps; dwells and ring-downs, `jointcal.synth.steady`) with the exact-Iwan simulator
+(plus the hidden effect, if any), passes both channels through the measurement chain
+(`jointcal.synth.daq`), and writes the campaign (manifest + one file per run) and, separately, the truth: parameters, effect
 and per run the harmonic-balance steady-state resonance at that level.
 """
 from __future__ import annotations
@@ -27,6 +27,7 @@ from .non_masing import KEY, share_of, with_share
 from .rig_truth import rig_truth
 from .shaker import Shaker, StructureMode, simulate_rig
 from .spec import JOINT_KEYS, RIG_LEVEL, load_spec
+from .steady import STEADY_PRIVATE, plan_steady, steady_band
 
 __all__ = ["generate", "plan_runs"]
 
@@ -49,6 +50,9 @@ def plan_runs(spec: dict) -> pd.DataFrame:
     for assembly in spec["assemblies"]:
         seq = 0
         for item in spec["series"]:
+            if item.get("test", "sweep") != "sweep":  # dwells or ring-downs: one run per drive frequency
+                seq = plan_steady(rows, item, assembly, seq, ref, float(spec["sample_rate_hz"]), spec["file_format"])
+                continue
             for _ in range(item.get("repeats", 1)):
                 for direction in item.get("directions", ["up", "down"]):
                     seq += 1
@@ -61,7 +65,10 @@ def plan_runs(spec: dict) -> pd.DataFrame:
                                      sweep_rate_hz_per_s=float(sw["rate_hz_per_s"]),
                                      sample_rate_hz=float(spec["sample_rate_hz"]),
                                      file=f"runs/{run_id}.{spec['file_format']}"))
-    return pd.DataFrame(rows)
+    plan = pd.DataFrame(rows)
+    if "test" in plan:  # a campaign with dwells or ring-downs: the sweeps say so too
+        plan["test"] = plan["test"].fillna("sweep")
+    return plan
 
 
 def _full_scale(setting: Any, peak: float) -> float:
@@ -137,10 +144,14 @@ def generate(spec: dict | str | os.PathLike, out_dir: str | os.PathLike, truth_p
         model = _model(truth, row.sequence, effect, eparams, spec["effect"].get("also"))
         level = row.level_g if ref == "base" else row.level_V
         # base: the controller holds the base acceleration (ripple); a rig's amplifier is open loop
-        t, f_inst, drive = daq.controlled_sweep(fs_sim, row.f_start_hz, row.f_stop_hz, row.sweep_rate_hz_per_s,
-                                           level, rng=run_rng, ramp_s=sw["ramp_s"], tail_s=sw["tail_s"],
-                                           ripple=meas["ripple"] if ref == "base" else 0.0,
-                                           distortion=tuple(meas["distortion"]))
+        swept = getattr(row, "test", "sweep") == "sweep"
+        f0, f1, rate, tail = ((row.f_start_hz, row.f_stop_hz, row.sweep_rate_hz_per_s, sw["tail_s"])
+                              if swept else steady_band(row))
+        # a dwell's drive is cut off, not ramped down: its ring-down starts from the steady state
+        t, f_inst, drive = daq.controlled_sweep(fs_sim, f0, f1, rate, level, rng=run_rng,
+                                                ramp_s=sw["ramp_s"] if swept else 0.0,
+                                                tail_s=tail, ripple=meas["ripple"] if ref == "base" else 0.0,
+                                                distortion=tuple(meas["distortion"]))
         if ref == "base" and share_of(model) > 0:
             raise ValueError(f"assembly {row.assembly!r}: {KEY} needs rig reference force or voltage (the base "
                              "rig's truth rows are the Iwan joint's harmonic balance); set rig.reference.")
@@ -166,7 +177,8 @@ def generate(spec: dict | str | os.PathLike, out_dir: str | os.PathLike, truth_p
         lev = {"level_g": row.level_g} if ref == "base" else {}
         truth_rows.append(dict(run_id=row.run_id, assembly=row.assembly, sequence=row.sequence,
                                **lev, direction=row.direction, **ranges, **extra))
-    write_csv_atomic(plan.drop(columns=["level_V"]) if ref == "force" else plan, out_dir / "manifest.csv")
+    manifest = plan.drop(columns=[c for c in STEADY_PRIVATE if c in plan])
+    write_csv_atomic(manifest.drop(columns=["level_V"]) if ref == "force" else manifest, out_dir / "manifest.csv")
     table = pd.DataFrame(truth_rows)
     write_json_atomic(dict(spec=spec, effect=dict(name=effect, params=eparams),
                            assemblies={a: dict(v, m=masses[a]) for a, v in spec["assemblies"].items()},

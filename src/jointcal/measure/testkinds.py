@@ -1,0 +1,207 @@
+"""The modal read-out of dwell and ring-down runs, and every run's amplitude-dependent points (backbone.csv).
+
+A sweep run is read by `jointcal.measure.campaign` as before and gives one point, its read-out.
+The runs of the other test kinds (`jointcal.io.test_kind`), in the order data flows:
+
+1. **The mode's frequency**: the largest peak of the response's spectrum over its free decay
+   (a ring-down, or a dwell's ring-down after the cut), else the dwell's frequency; the nearest of
+   ``modal.mode_hz`` when given. Runs are named after the assembly's swept mode within `NEAR` of
+   it, else grouped (frequencies within `NEAR`) and named by the lowest level's read-out (its
+   largest ring-down window's frequency, else its spectral peak; `jointcal.measure.modes.mode_name`).
+2. **Ring-down windows** (`jointcal.measure.ringdown.ringdown_backbone`): a ring-down, and a dwell
+   whose record goes on for at least `MIN_DECAY_S` after its drive is cut, give one point per window.
+3. **Dwell points** (`jointcal.measure.dwell`): each dwell's steady point; a level's dwells (three
+   or more per assembly, mode and level) give the modal constant and so each dwell's natural
+   frequency and damping at the amplitude it reached, and the level's phase resonance.
+
+Each run keeps one row in modal_properties.csv (a ring-down's largest-amplitude window, a dwell's
+point), ``f_res_method`` naming the read-out, so the later stages read it like a sweep's.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from ..io._contract import LEVEL, REFERENCE, RESPONSE
+from ..io._kinds import DWELL
+from ..units import G
+from .dwell import dwell_mode, dwell_point
+from .modes import mode_name
+from .peaks import parabola_vertex
+from .ringdown import decay_start, ringdown_backbone
+
+__all__ = ["other_kinds_modal", "backbone_table", "BACKBONE_COLUMNS", "MIN_DECAY_S", "NEAR"]
+
+BACKBONE_COLUMNS = ["run_id", "mode", "test", "q_in", "f_hz", "zeta"]
+MIN_DECAY_S = 1.0  # a dwell's record this long after the cut holds a ring-down to read (as decay_start asks)
+NEAR = 0.1  # relative distance within which two frequencies are one mode
+IDENTITY = ("run_id", "assembly", "sequence", "direction")
+
+
+def _peak_hz(x: np.ndarray, fs: float, lo: float = 0.5, decay: bool = False) -> float:
+    """The largest spectral peak of `x` above `lo` Hz (8x zero padding, parabola on the log).
+
+    A decay is cut where it last stands 20x over its tail's median (the noise) and read without a
+    window (it tapers itself); any other record under a Hann window.
+    """
+    if decay:
+        a = np.abs(x - np.median(x))
+        noise = np.median(a[-max(a.size // 10, 1):])
+        x = x[:max(int(np.flatnonzero(a > 20 * noise)[-1]) + 1 if (a > 20 * noise).any() else a.size, 64)]
+    y = (x - x.mean()) * (1.0 if decay else np.hanning(x.size))
+    n = 8 * x.size
+    mag = np.abs(np.fft.rfft(y, n))
+    mag[: int(np.ceil(lo * n / fs)) + 1] = 0.0
+    k = int(np.argmax(mag))
+    if 0 < k < mag.size - 1:
+        k = k + float(parabola_vertex(*np.log(mag[k - 1:k + 2] + 1e-300))[0])
+    return float(k * fs / n)
+
+
+def _decay(resp: np.ndarray, ref: np.ndarray, fs: float) -> int | None:
+    """The decay's start (from the drive when it holds one, else from the response), None without one."""
+    live = np.abs(ref - np.median(ref)).max() > 0
+    try:
+        start = decay_start(fs, resp, ref - np.median(ref) if live else None)
+    except ValueError:
+        return None
+    return start if (resp.size - start) / fs >= MIN_DECAY_S else None
+
+
+def _read_run(row: dict, record: pd.DataFrame, kind: str, mode_hz) -> dict:
+    """One run's frequency, ring-down windows and dwell point."""
+    fs = float(row["sample_rate_hz"])
+    resp = np.nan_to_num(record[RESPONSE].to_numpy(float))
+    ref = np.nan_to_num(record[REFERENCE[kind]].to_numpy(float))
+    start = _decay(resp, ref, fs)
+    if start is not None:
+        f = _peak_hz(resp[start:], fs, decay=True)
+    elif row.get("test") == "dwell":
+        f = float(row[DWELL])
+    else:
+        f = _peak_hz(resp, fs)
+    if mode_hz is not None:
+        f = min((float(v) for v in np.atleast_1d(mode_hz)), key=lambda v: abs(v - f))
+    out = {"row": row, "f_guess": f, "windows": None, "point": None, "notes": []}
+    if start is not None:
+        out["windows"] = ringdown_backbone(resp, fs, f, start=start)
+    if row.get("test") == "dwell":
+        out["point"] = dwell_point(resp, ref, fs, float(row[DWELL]), kind)
+    return out
+
+
+def _names(reads: list[dict], swept: dict[str, float], level: str) -> None:
+    """Each read-out's mode: the swept mode within NEAR, else its group's name at the lowest level."""
+    for r in reads:
+        near = [(abs(f / r["f_guess"] - 1), m) for m, f in swept.items() if abs(f / r["f_guess"] - 1) < NEAR]
+        r["mode"] = min(near)[1] if near else None
+    rest = sorted((r for r in reads if r["mode"] is None), key=lambda r: r["f_guess"])
+    groups: list[list[dict]] = []
+    for r in rest:
+        if groups and r["f_guess"] / groups[-1][-1]["f_guess"] - 1 < NEAR:
+            groups[-1].append(r)
+        else:
+            groups.append([r])
+    for g in groups:
+        low = min(g, key=lambda r: (float(r["row"].get(level, np.inf)), str(r["row"]["run_id"])))
+        w = low["windows"]  # named by its read-out, as a sweep's mode: the largest window's frequency
+        f = float(w.loc[w["q_in"].idxmax(), "f_hz"]) if w is not None and len(w) else low["f_guess"]
+        for r in g:
+            r["mode"] = mode_name(f)
+
+
+def other_kinds_modal(rows: list[dict], records: dict, kind: str, swept: dict[str, float],
+                      mode_hz=None) -> tuple[list[dict], list[dict]]:
+    """The modal rows and backbone points of one assembly's dwell and ring-down runs.
+
+    Parameters
+    ----------
+    rows : list of dict
+        The runs' rows of runs.csv (``test`` ``dwell`` or ``ringdown``).
+    records : dict of run_id to DataFrame
+        Their records (`jointcal.io.read_run`).
+    kind : {'base', 'force', 'voltage'}
+        The assembly's excitation.
+    swept : dict of str to float
+        The assembly's swept modes: name -> frequency (Hz) at their lowest level.
+    mode_hz : float or list of float, optional
+        The config's ``modal.mode_hz``.
+
+    Returns
+    -------
+    modal : list of dict
+        One modal_properties.csv row per run.
+    points : list of dict
+        `BACKBONE_COLUMNS` rows: each ring-down window (``test`` ``ringdown``) and each dwell's point.
+    """
+    level = LEVEL[kind]
+    reads = [_read_run(r, records[r["run_id"]], kind, mode_hz) for r in rows if records.get(r["run_id"]) is not None]
+    _names(reads, swept, level)
+    dwells: dict[tuple, list[dict]] = {}
+    for r in reads:
+        if r["point"] is not None:
+            dwells.setdefault((r["mode"], float(r["row"][level])), []).append(r)
+    for group in dwells.values():
+        pts = [r["point"] for r in group]
+        if len(pts) < 3:  # no modal constant: the points' frequencies and damping cannot be read
+            nan = float("nan")
+            for r in group:
+                r["dwell"] = {"q_in": r["point"]["q_in"], "f_hz": nan, "zeta": nan,
+                              "fit": {"f_hz": nan, "zeta": nan, "q_in": nan, "residual": nan, "flags": ["few_dwells"]}}
+            continue
+        fit = dwell_mode(np.array([p["f_hz"] for p in pts]), np.array([p["X"] for p in pts]),
+                         np.array([p["q_in"] for p in pts]), A=-G if kind == "base" else None)
+        for r, (q, f, z) in zip(group, fit["points"]):
+            r["dwell"] = {"q_in": q, "f_hz": f, "zeta": z, "fit": fit}
+    modal, points = [], []
+    for r in reads:
+        row, rid = r["row"], r["row"]["run_id"]
+        w = r["windows"]
+        if w is not None and len(w):
+            points += [{"run_id": rid, "mode": r["mode"], "test": "ringdown", "q_in": q, "f_hz": f, "zeta": z}
+                       for q, f, z in zip(w["q_in"], w["f_hz"], w["zeta"])]
+        out = {**{k: row.get(k) for k in IDENTITY}, level: row.get(level), "mode": r["mode"],
+               "test": row.get("test"), "mode_peak_hz": r["f_guess"]}
+        flags = []
+        if row.get("test") == "dwell" and np.isfinite(r["dwell"]["f_hz"]):
+            d, p = r["dwell"], r["point"]
+            fit = d["fit"]
+            flags += p["flags"] + fit["flags"]
+            points.append({"run_id": rid, "mode": r["mode"], "test": "dwell", **{k: d[k] for k in
+                                                                                 ("q_in", "f_hz", "zeta")}})
+            out.update(f_res_hz=d["f_hz"], zeta_res=d["zeta"], q_in=d["q_in"], f_res_method="dwell",
+                       dwell_hz=p["f_hz"], dwell_ratio_re=p["ratio"].real, dwell_ratio_im=p["ratio"].imag,
+                       f_dwell_quad_hz=fit["f_hz"], zeta_dwell_quad=fit["zeta"], q_dwell_quad_in=fit["q_in"],
+                       dwell_residual=fit["residual"])
+        elif w is not None and len(w):  # a ring-down, or a dwell read only along its ring-down
+            flags += r["dwell"]["fit"]["flags"] if r.get("dwell") else []
+            top = w.loc[w["q_in"].idxmax()]
+            out.update(f_res_hz=top["f_hz"], zeta_res=top["zeta"], q_in=top["q_in"], f_res_method="ringdown")
+        else:
+            flags += (r["dwell"]["fit"]["flags"] if r.get("dwell") else ["no_decay"]) + ["unusable"]
+        if w is not None and len(w):
+            out["ringdown_windows"] = len(w)
+            out["ringdown_decades"] = float(np.log10(w["q_in"].max() / w["q_in"].min()))
+        out.update(zeta_phase_resonance=out.get("zeta_res"), zeta_half_power=out.get("zeta_res"),
+                   flags=";".join(dict.fromkeys(flags)))
+        modal.append(out)
+    return modal, points
+
+
+def backbone_table(modal: pd.DataFrame, points: list[dict]) -> pd.DataFrame:
+    """backbone.csv: every sweep row's read-out (``q_in``, ``f_res_hz``, ``zeta_res``) and the other kinds' points.
+
+    The rows flagged ``unusable`` are left out; the order is the modal table's runs, windows in time order.
+    """
+    usable = ~modal["flags"].fillna("").str.contains("unusable")
+    method = modal["f_res_method"] if "f_res_method" in modal else pd.Series("", index=modal.index)
+    sweep = ~method.isin(["dwell", "ringdown"])
+    rows = modal.loc[usable & sweep]
+    out = [pd.DataFrame({"run_id": rows["run_id"], "mode": rows["mode"], "test": "sweep", "q_in": rows["q_in"],
+                         "f_hz": rows["f_res_hz"], "zeta": rows["zeta_res"]})]
+    bad = set(modal.loc[~usable, "run_id"])
+    out.append(pd.DataFrame([p for p in points if p["run_id"] not in bad], columns=BACKBONE_COLUMNS))
+    table = pd.concat(out, ignore_index=True)
+    order = {r: i for i, r in enumerate(dict.fromkeys(modal["run_id"]))}
+    key = table["run_id"].map(order)
+    return table.iloc[np.argsort(key.to_numpy(), kind="stable")].reset_index(drop=True)
