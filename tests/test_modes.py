@@ -132,3 +132,29 @@ def test_a_voltage_driven_chirp_over_two_modes_reads_each(tmp_path):
     assert jointed["f_res_hz"].max() / jointed["f_res_hz"].min() - 1 > 0.01  # the joint softens over the levels
     assert linear["f_res_hz"].max() / linear["f_res_hz"].min() - 1 < 5e-4  # the linear mode does not
     assert linear["zeta_res"].max() / linear["zeta_res"].min() - 1 < 0.05
+
+
+def test_a_voltage_coil_is_fitted_on_the_slowest_sweeps_and_held_where_most_of_them_ask_for_it(monkeypatch):
+    """`assembly_coil` on a plan of four runs of one mode (two at the slowest rate): only the slowest are read with
+    the coil fitted; their median is held when both ask for one, none when only one of the two does; the
+    note names the runs."""
+    import jointcal.measure.campaign as camp
+
+    fits = {"a": (1000.0, 5e5), "b": (1100.0, 7e5), "c": (1.0, 1.0), "d": (1.0, 1.0)}
+    calls = []
+
+    def fake(env, row, *, coil, **kw):
+        calls.append((row["run_id"], coil))
+        w_e, g = fits[row["run_id"]]
+        return {"coil_w_e_rad_s": w_e, "coil_g_per_s2": g} if np.isfinite(w_e) else {}
+
+    monkeypatch.setattr(camp, "modal_properties", fake)
+    rates = {"a": 1.0, "b": 1.05, "c": 5.0, "d": 50.0}
+    rows = [{"run_id": r, "assembly": "A1", "sweep_rate_hz_per_s": v} for r, v in rates.items()]
+    loaded = {r["run_id"]: (r, None, {}, pd.DataFrame()) for r in rows}
+    plan = [(r, 95.0, "m95") for r in rows]
+    notes = []
+    assert camp.assembly_coil(plan, loaded, {}, notes) == {"m95": (1050.0, 6e5)}
+    assert calls == [("a", "fit"), ("b", "fit")] and "fitted on a, b" in notes[0]
+    fits["b"] = (np.nan, np.nan)  # one of the two slowest does not ask for a coil: none held
+    assert camp.assembly_coil(plan, loaded, {}, []) == {"m95": None}

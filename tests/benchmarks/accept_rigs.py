@@ -24,6 +24,9 @@ errors of the resonance and damping against
 * 'reached': at the largest amplitude the simulated sweep reached near that resonance
   (a fast chirp never builds the steady state; for a nonlinear joint they differ).
 
+A voltage drive's coil (corner R / L, back-EMF gain) is fitted on each structure's slowest sweep and
+held for all its voltage runs, as `jointcal.measure.campaign.assembly_coil` does for a campaign.
+
 Structures: 'ministack' (Table 3.2, first assembly, 2.65 lbf slug, ~2.25 kHz at the
 level used), 'beam' (linear, 1 lbf, 100 Hz, zeta 1.5%), 'beam_joint' (the beam with a
 light Iwan joint in parallel: a softening, lightly nonlinear 100 Hz mode).
@@ -74,7 +77,7 @@ def _volts(asm: dict, shaker: dict, q_target: float | None) -> float:
 
 
 def one_case(name: str, ref: str, eta: float, tmp: Path, *, seed: int = 11, noise: float = 0.003,
-             direction: str = "up") -> dict:
+             direction: str = "up", coil=None) -> dict:
     asm, shaker, (lo, hi), fs, tail, q_target = STRUCTURES[name]
     volts = _volts(asm, shaker, q_target)
     truth = {k: v for k, v in asm.items() if k != "weight_lbf"}
@@ -95,7 +98,7 @@ def one_case(name: str, ref: str, eta: float, tmp: Path, *, seed: int = 11, nois
     tr = generate(spec, folder, tmp / f"{tag}.json").iloc[0]
     row = read_manifest(folder / "manifest.csv").iloc[0].to_dict()
     mass = asm.get("weight_lbf", 2.65)  # the modal mass: force-driven energy balance needs it
-    props = measure_run(read_run(folder / row["file"]), row, modal_kw={"mass_lbf": mass})[2]
+    props = measure_run(read_run(folder / row["file"]), row, modal_kw={"mass_lbf": mass, "coil": coil})[2]
     key_f, key_z = ("f_hb_hz", "zeta_hb") if ref == "force" else ("f_rig_hz", "zeta_rig")
     zeta = {"sweep_fit": props["zeta_sweep"], "frf_backbone": props["zeta_backbone"]}.get(props["f_res_method"],
                                                                                          props["zeta_frf"])
@@ -114,7 +117,8 @@ def one_case(name: str, ref: str, eta: float, tmp: Path, *, seed: int = 11, nois
                 zeta_err_reached=zeta / tr[key_z + "_reached"] - 1,
                 q_reached_over_ss=(tr["q_reached_in"] / tr["q_ss_in"] if ref == "force"
                                    else tr["q_rig_reached_in"] / tr["q_rig_ss_in"]), residual=props["frf_residual"],
-                f_peak_err=props["f_peak_hz"] / tr[key_f] - 1, flags=props["flags"])
+                f_peak_err=props["f_peak_hz"] / tr[key_f] - 1, flags=props["flags"],
+                coil=(props["coil_w_e_rad_s"], props["coil_g_per_s2"]) if "coil_w_e_rad_s" in props else None)
 
 
 def main(quick: bool = False) -> pd.DataFrame:
@@ -124,8 +128,13 @@ def main(quick: bool = False) -> pd.DataFrame:
     with tempfile.TemporaryDirectory() as d:
         for name in STRUCTURES:
             for ref in ("force", "voltage"):
+                # a voltage drive's coil is the rig's: fitted on the slowest sweep, held for all (as
+                # jointcal.measure.campaign.assembly_coil does for a campaign's runs)
+                coil = one_case(name, ref, min(etas), Path(d), coil="fit")["coil"] if ref == "voltage" else None
+                if ref == "voltage":
+                    print(f"{name:10s} voltage: coil fitted at eta {min(etas):g}: {coil}", flush=True)
                 for eta in etas:
-                    rows.append(one_case(name, ref, eta, Path(d)))
+                    rows.append(one_case(name, ref, eta, Path(d), coil=coil))
                     r = rows[-1]
                     print(f"{name:10s} {ref:7s} eta {eta:5.1f} ({r['eta_meas']:6.2f}) {r['method']:12s} "
                           f"AT LEVEL (q/q_ss {r['q_level_over_ss']:.2f}): f err {100 * r['f_err_level']:+.4f}% "

@@ -43,8 +43,9 @@ def excited_readout(env_out, fit, sweep, why, flags, kind, f_bb, z_bb, rate_hz_p
         env_out["zeta_phase_resonance"] = zeta_at_quadrature(fit) * (G / mass_lbf) / fit.modal_constant
     if sweep is not None:
         q_peak = band_envelope_peak(record, row, kind, sweep.f_hz)
-        env_out["sweep_note"] = ("the record began with the mode already moving: its start state fitted"
-                                 if sweep.start_fitted else "")
+        env_out["sweep_note"] = "; ".join(filter(None, (
+            "the record began with the mode already moving: its start state fitted" if sweep.start_fitted else "",
+            sweep.coil_text())))
         flags += ["sweep_truncated"] * sweep.ringing_end
         return dict(f_res_hz=sweep.f_hz, f_res_method="sweep_fit", q_in=sweep.q_in, zeta_res=sweep.zeta,
                     q_peak_in=q_peak, eta=rate_hz_per_s / (sweep.f_hz * sweep.zeta) ** 2)
@@ -93,11 +94,12 @@ def band_envelope_peak(record: pd.DataFrame | None, row: dict, kind: str, f_hz: 
     return float(env.max() / w**2) if env.size else np.nan
 
 
-def sweep_estimate(record, row, kind, fit, env_out, z_bb, band, max_residual):
+def sweep_estimate(record, row, kind, fit, env_out, z_bb, band, max_residual, coil=None):
     """The swept-mode fit (`jointcal.measure.sweepfit`) of a force- or voltage-driven run and, when it is
     not used, why: (SweepFit or None, reason). Started from the FRF read-out (else the envelope peak); the
     fit scans its own damping. Not this mode when its misfit exceeds max_residual, its damping lies
-    outside (0, ZETA_MAX) or its resonance outside the band or more than SWEEP_FRAME from the start."""
+    outside (0, ZETA_MAX) or its resonance outside the band or more than SWEEP_FRAME from the start. coil: a
+    voltage drive's coil ('fit' or (w_e, g), `fit_swept_mode`), ignored for other drives."""
     if record is None:
         return None, "no record"
     f0 = fit.f_n_hz if fit is not None else env_out["f_peak_hz"]
@@ -108,7 +110,8 @@ def sweep_estimate(record, row, kind, fit, env_out, z_bb, band, max_residual):
     def fit(f_start, z_start):
         return fit_swept_mode(record[REFERENCE[kind]].to_numpy(float), record[RESPONSE].to_numpy(float),
                               float(row["sample_rate_hz"]), float(f_start), float(z_start),
-                              modal_phase=0.0 if kind == "force" else None)
+                              modal_phase=0.0 if kind == "force" else None,
+                              coil=coil if kind == "voltage" else None)
 
     try:
         sw = fit(f0, z0)

@@ -6,21 +6,24 @@ accepts.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
+from ._coil import N_COIL_DIRECTIONS, coil_mode_sensitivity
 from ._rotating import Passage, rotating_mode
 from ._rotating_sensitivity import N_DIRECTIONS, rotating_mode_sensitivity
+from ._sweep_starts import starts as _starts
 
 __all__ = ["Problem", "fit_from_starts", "earned_terms"]
 
 
-NP = 22  # parameters: the mode's 18, and its start state's 4 where the record begins in motion
+NP = 24  # parameters: the mode's 18, its start state's 4 where the record begins in motion, a coil's 2
 X_SCALE = np.array([1e-3, 0.1, 0.01, 0.01, 0.2, 0.2, 0.1, 0.1, 0.2, 0.5, 0.5, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01,
-                    0.05, 0.05, 0.05, 0.05])
+                    0.05, 0.05, 0.05, 0.05, 0.05, 0.01])
+COIL_RANGE = (0.05, 2.0)  # the coil's corner w_e / W0 fitted within (RK4's step bounds |w_e + i W0| h)
 LOWER, UPPER = np.full(NP, -np.inf), np.full(NP, np.inf)
 LOWER[8], UPPER[8] = 0.0, 1.0  # phi, the hysteretic share of the damping
 
@@ -34,7 +37,8 @@ class Problem:
     quadratic and cubic terms in L; p[4:6]: ln D's; p[6:8]: the modal constant over `a_abs`; p[8]: phi;
     p[9:11]: the modal constant's slope; p[11:15], p[16:18]: the residual terms over `b_abs`;
     p[18:22] (a passage with `free_start`): the start state's correction, Z over q_ref and Z' over
-    q_ref W0, real and imaginary parts.
+    q_ref W0, real and imaginary parts; p[22], p[23] (a voltage drive's coil, `jointcal.measure._coil`):
+    w_e = coil[0] exp(p[22]) and g = coil[1] + W0^2 p[23], held (`coil` alone) or fitted (`coil_free`).
     """
 
     ps: Passage
@@ -54,6 +58,8 @@ class Problem:
     norm: float
     n_res: int
     jacobian: str = "sensitivity"
+    coil: tuple[float, float] | None = None  # (w_e rad/s, g 1/s^2): held, or the start where coil_free
+    coil_free: bool = False
     memo: dict = field(default_factory=dict, init=False, compare=False, repr=False)  # the last Jacobian
 
     @classmethod
@@ -87,6 +93,8 @@ class Problem:
         a = p[6] * self.rot if self.fixed else p[6] + 1j * p[7]
         mode = np.array([W0**2 * np.exp(2 * p[0]), 2 * zeta0 * W0 * np.exp(p[1]), p[2], p[3], p[4], p[5],
                          a.real * a_abs, a.imag * a_abs, p[8], p[9] * a_abs, p[10] * a_abs, p[15]])
+        if self.coil is not None:
+            mode = np.append(mode, [self.coil[0] * np.exp(p[22]), self.coil[1] + W0**2 * p[23]])
         return mode, self.b_abs * np.array([complex(p[11], p[12]), complex(p[13], p[14]), complex(p[16], p[17])])
 
     def response(self, pf: NDArray, free: NDArray) -> tuple[NDArray, NDArray]:
@@ -96,8 +104,24 @@ class Problem:
         p = np.zeros(NP)
         p[free] = pf
         z0, y0 = self._start(p)
-        Z, acc = rotating_mode(s.R, s.Rd, s.Rm, s.Rdm, s.W0, s.h, mode, self.q_ref, self.l_lo, self.l_hi, z0, y0)
+        if self.coil is None:
+            Z, acc = rotating_mode(s.R, s.Rd, s.Rm, s.Rdm, s.W0, s.h, mode, self.q_ref, self.l_lo, self.l_hi, z0, y0)
+        else:
+            none = np.empty(0, np.int64)
+            Z, acc, _ = coil_mode_sensitivity(s.R, s.Rd, s.Rm, s.Rdm, s.W0, s.h, mode, self.q_ref, self.l_lo,
+                                              self.l_hi, z0, y0, self._nu(), none, np.zeros((0, 0)), none)
         return Z, acc + self.residual_basis @ b  # residual terms: the other modes' mass or stiffness lines
+
+    def with_coil(self, coil: tuple[float, float], free: bool) -> Problem:
+        """The same passage with a voltage drive's coil (w_e rad/s, g 1/s^2): held, or fitted from it."""
+        extra = [22, 23] if free else []
+        return replace(self, coil=(float(coil[0]), float(coil[1])), coil_free=free,
+                       free_all=np.concatenate([self.free_all[self.free_all < 22], extra]).astype(int))
+
+    def _nu(self) -> complex:
+        """Z' / Z at the passage's start (1/s; 0 from rest): the coil's forced start."""
+        ps = self.ps
+        return complex(ps.y_start / ps.z_start) if ps.z_start != 0 else 0j
 
     def _start(self, p: NDArray) -> tuple[complex, complex]:
         """The integration's start state (Z in, Z' in/s): the passage's, corrected where it is fitted."""
@@ -142,8 +166,14 @@ class Problem:
         basis, columns = self.memo["basis"]
         z0, y0 = self._start(p)
         with np.errstate(all="ignore"):  # a trial step may diverge: a large misfit, not a warning
-            _, acc, dacc = rotating_mode_sensitivity(s.R, s.Rd, s.Rm, s.Rdm, s.W0, s.h, mode, self.q_ref, self.l_lo,
-                                                     self.l_hi, z0, y0, dirs, chain[dirs], np.flatnonzero(sel))
+            if self.coil is None:
+                _, acc, dacc = rotating_mode_sensitivity(s.R, s.Rd, s.Rm, s.Rdm, s.W0, s.h, mode, self.q_ref,
+                                                         self.l_lo, self.l_hi, z0, y0, dirs, chain[dirs],
+                                                         np.flatnonzero(sel))
+            else:
+                _, acc, dacc = coil_mode_sensitivity(s.R, s.Rd, s.Rm, s.Rdm, s.W0, s.h, mode, self.q_ref, self.l_lo,
+                                                     self.l_hi, z0, y0, self._nu(), dirs, chain[dirs],
+                                                     np.flatnonzero(sel))
             res = (acc[sel] + (basis[:, 0] * b[0] + basis[:, 1] * b[1] + basis[:, 2] * b[2]) - s.Acc[sel]) / self.peak
             jac = (dacc + columns[:, free]) / self.peak
         jac[~(np.isfinite(res) & (np.abs(res) < 1e3))] = 0.0  # a clamped residual does not move
@@ -171,13 +201,16 @@ class Problem:
 
     def _chain(self) -> NDArray:
         """d (kernel direction) / d p, shape (N_DIRECTIONS, NP): how the scaled parameters enter the kernel."""
-        t, a_abs, qw = np.zeros((N_DIRECTIONS, NP)), self.a_abs, self.q_ref * self.ps.sig.W0
+        t = np.zeros((N_DIRECTIONS if self.coil is None else N_COIL_DIRECTIONS, NP))
+        a_abs, qw = self.a_abs, self.q_ref * self.ps.sig.W0
         t[0, 0], t[1, 1] = 2.0, 1.0  # ln Omega_ref^2 = ln W0^2 + 2 p[0]; ln D_ref = const + p[1]
         t[2, 2], t[3, 3], t[4, 4], t[5, 5], t[8, 8], t[11, 15] = 1.0, 1.0, 1.0, 1.0, 1.0, 1.0
         t[6, 6], t[7, 6] = (a_abs * self.rot.real, a_abs * self.rot.imag) if self.fixed else (a_abs, 0.0)
         t[7, 7], t[9, 9], t[10, 10] = (0.0 if self.fixed else a_abs), a_abs, a_abs
         if self.ps.free_start:
             t[12, 18], t[13, 19], t[14, 20], t[15, 21] = self.q_ref, self.q_ref, qw, qw
+        if self.coil is not None:
+            t[16, 22], t[17, 23] = 1.0, self.ps.sig.W0**2  # ln w_e = ln coil[0] + p[22]; g = coil[1] + W0^2 p[23]
         return t
 
     def _residual_columns(self, sel: NDArray) -> NDArray:
@@ -193,8 +226,13 @@ class Problem:
     def solve(self, p0: NDArray, free: NDArray, max_nfev: int):
         """`scipy.optimize.least_squares` of `misfit` over the free parameters from p0 (their values)."""
         jac = self.jacobian_matrix if self.jacobian == "sensitivity" else "2-point"
+        lower, upper = LOWER.copy(), UPPER.copy()
+        if self.coil is not None:
+            W0 = self.ps.sig.W0
+            lower[22], upper[22] = np.log(np.array(COIL_RANGE) * W0 / self.coil[0])
+            lower[23] = -self.coil[1] / W0**2  # g >= 0
         return least_squares(self.misfit, p0, jac=jac, args=(free,), x_scale=X_SCALE[free],
-                             bounds=(LOWER[free], UPPER[free]), max_nfev=max_nfev)
+                             bounds=(lower[free], upper[free]), max_nfev=max_nfev)
 
     def relative(self, sol) -> float:
         """Relative RMS misfit of a solution: `SweepFit.residual`."""
@@ -202,7 +240,7 @@ class Problem:
 
 
 def fit_from_starts(prob: Problem, free: NDArray, f0: float, zeta0: float):
-    """The best least-squares solution from `_starts`' start values (lazily: a good fit ends the scan)."""
+    """The best least-squares solution from `jointcal.measure._sweep_starts.starts`' start values (lazily: a good fit ends the scan)."""
     s = prob.ps.sig
     best, rel = None, np.inf
     for f_s, z_s, a_s, b0_s, b1_s, b2_s in _starts(s.R, s.Rd, s.Rm, s.Rdm, s.Rdd, s.Acc, prob.ps.sel, s.h, s.W0, f0,
@@ -255,45 +293,3 @@ def earned_terms(prob: Problem, best, free: NDArray, frequency_curvature: str, e
     if better(best, trial, free.size - no_b.size, earn):
         return best, free
     return trial, no_b
-
-
-def _linear_mode(R, Rd, Rm, Rdm, Rdd, Acc, sel, h, W0, f, z, fixed, rot):
-    """(misfit norm, A, B_0, B_1, B_2) of a linear mode (f Hz, zeta): its modal constant and residual
-    terms by linear least squares (complex; real projections for a fixed phase)."""
-    mode = np.array([(2 * np.pi * f) ** 2, 4 * np.pi * f * z, 0, 0, 0, 0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0])
-    with np.errstate(all="ignore"):
-        x = rotating_mode(R, Rd, Rm, Rdm, W0, h, mode, 1.0, -1.0, 1.0, 0j, 0j)[1][sel]
-    if not np.all(np.isfinite(x)):
-        return np.inf, 1.0 + 0j, 0j, 0j, 0j
-    cols = np.stack([x, R[sel], -1j * Rd[sel] / W0, -Rdd[sel] / W0**2], axis=1)
-    y = Acc[sel]
-    if fixed:  # real coefficients of (A e^{-i phase}) x, R, -i R'/W0
-        cols = cols * np.array([rot, 1.0, 1.0, 1.0])
-        c, *_ = np.linalg.lstsq(np.concatenate([cols.real, cols.imag]), np.concatenate([y.real, y.imag]), rcond=None)
-        c = c.astype(complex)
-        c[0] = c[0] * rot
-    else:
-        c, *_ = np.linalg.lstsq(cols, y, rcond=None)
-    full = np.stack([x, R[sel], -1j * Rd[sel] / W0, -Rdd[sel] / W0**2], axis=1)
-    return float(np.linalg.norm(y - full @ c)), *map(complex, c)
-
-
-def _starts(R, Rd, Rm, Rdm, Rdd, Acc, sel, h, W0, f0, zeta0, fixed, rot, n_keep=3):
-    """Start values (f Hz, zeta, A, B_0, B_1, B_2) of the nonlinear fit, lazily: the caller's (f0, zeta0) first; then,
-    only if the fit from it is poor, a scan of linear modes over frequencies within +-5% of f0 (or 4
-    half-power widths) and damping ratios from zeta0 / 10 to 10 zeta0 (a chirp faster than the mode, or
-    a bent peak, can put an FRF's damping a decade off), the n_keep best distinct ones. A and the
-    residual terms start from each linear mode's least squares."""
-    args = (R, Rd, Rm, Rdm, Rdd, Acc, sel, h, W0)
-    yield f0, zeta0, *_linear_mode(*args, f0, zeta0, fixed, rot)[1:]
-    df = min(0.05, max(4 * zeta0, 0.002))
-    rows = [(*_linear_mode(*args, f, z, fixed, rot), f, z)
-            for f in f0 * (1 + df * np.linspace(-1, 1, 9)) for z in zeta0 * np.geomspace(0.1, 10.0, 11) if 0 < z < 0.5]
-    rows.sort(key=lambda r: r[0])
-    kept = [(f0, zeta0)]
-    for _, a, b0, b1, b2, f, z in rows:
-        if all(abs(f / g - 1) > df / 8 or abs(np.log(z / w)) > 0.3 for g, w in kept):
-            kept.append((f, z))
-            yield f, z, a, b0, b1, b2
-        if len(kept) > n_keep:
-            break

@@ -19,6 +19,14 @@ peak (or at each ``modal.mode_hz``), and its mode is named from the read-out at 
 assembly's lowest level. So is every run of an assembly in which no resonance passes the
 tests of `modal_peaks`. A run whose band holds none of its assembly's modes gets one row,
 flagged ``no_mode`` and unusable.
+
+With ``modal: {coil: true}`` (off by default), a voltage drive's coil (its corner R / L and back-EMF gain:
+`jointcal.measure.sweepfit`) is a constant of the rig: per assembly and mode it is fitted on the slowest
+sweeps (`assembly_coil`) and held for every run, where one fast chirp barely identifies it. Off by default
+because, measured on the virtual Ministack voltage rig (tests/benchmarks/accept_rigs.py), it reads the
+damping closer (1.26% -> 0.90% at worst) and the frequency closer at eta 0.1-5 (+0.033 -> +0.020% at eta 0.5)
+but further at eta 20 (+0.018 -> -0.036%), and a single mode's sweeps do not identify the back-EMF gain
+(fitted 8-9x the rig's). Force- and base-driven runs are read without it.
 """
 from __future__ import annotations
 
@@ -35,7 +43,7 @@ from .modal import modal_properties
 from .modes import mode_name, modal_peaks, track_modes
 from .testkinds import other_kinds_modal
 
-__all__ = ["campaign_modal", "run_peaks"]
+__all__ = ["campaign_modal", "run_peaks", "assembly_coil"]
 
 IDENTITY = ("run_id", "assembly", "sequence", "direction")
 
@@ -105,6 +113,7 @@ def campaign_modal(runs: pd.DataFrame, load: Callable[[dict], tuple], modal_kw: 
     """
     kw = dict(modal_kw or {})
     mode_hz = kw.pop("mode_hz", None)
+    with_coil = bool(kw.pop("coil", False))
     loaded, rows, frf, notes, others = {}, [], {}, [], []
     for row in runs.to_dict("records"):
         if kind_of(row) != "sweep":
@@ -125,14 +134,16 @@ def campaign_modal(runs: pd.DataFrame, load: Callable[[dict], tuple], modal_kw: 
         first = loaded[grows[0]["run_id"]]
         kind = excitation_kind([*(first[3].columns if first[3] is not None else []), *first[0]])
         read = []
-        for row, guess, name in _plan(grows, {r: v[3] for r, v in loaded.items()}, kind, mode_hz):
+        plan = _plan(grows, {r: v[3] for r, v in loaded.items()}, kind, mode_hz)
+        coils = assembly_coil(plan, loaded, kw, notes) if kind == "voltage" and with_coil else {}
+        for row, guess, name in plan:
             _, env, meta, record = loaded[row["run_id"]]
             if guess == "none":
                 rows.append({**{k: row.get(k) for k in IDENTITY}, "mode": "", "flags": "no_mode;unusable"})
                 continue
             rate = meta.get("rate_hz_per_s", row["sweep_rate_hz_per_s"])
             out, tab = modal_properties(env, row, rate_hz_per_s=rate, record=record, with_frf=True,
-                                        mode_hz=guess, **kw)
+                                        mode_hz=guess, coil=coils.get(name or guess), **kw)
             out["window_s"] = meta.get("window_s")
             out["mode_peak_hz"] = float(guess) if guess is not None else float("nan")
             read.append((out, tab, guess, name))
@@ -165,6 +176,55 @@ def _other_kinds(others: list[dict], rows: list[dict], load: Callable, mode_hz, 
         rows += modal
         if points is not None:
             points += pts
+
+
+def assembly_coil(plan: list, loaded: dict, kw: dict, notes: list[str]) -> dict:
+    """The voltage drive's coil of one assembly, per mode: fitted on its slowest sweeps, held for the rest.
+
+    Each mode's runs within 10% of its slowest sweep rate are read with the coil fitted
+    (`jointcal.measure.modal.modal_properties`, ``coil='fit'``); the coil is the median of the
+    corners and back-EMF gains that earned their place, where more than half of them did (a rig's constant
+    is asked for by most of its runs: on the real UNESP beam one run of six takes a corner at the range's
+    edge); else the mode is read without one.
+
+    Parameters
+    ----------
+    plan : list of (row, start, name)
+        The assembly's read-outs (`_plan`).
+    loaded : dict of run_id to (row, env, meta, record)
+    kw : dict
+        `modal_properties`' keywords.
+    notes : list of str
+        A sentence per mode read with a coil is appended.
+
+    Returns
+    -------
+    dict of mode key (name, else start) to (w_e rad/s, g 1/s^2) or None
+    """
+    reads = {}
+    for row, guess, name in plan:
+        if guess != "none":
+            meta = loaded[row["run_id"]][2]
+            reads.setdefault(name or guess, []).append(
+                (abs(float(meta.get("rate_hz_per_s", row["sweep_rate_hz_per_s"]))), row, guess))
+    coils = {}
+    for key, runs in reads.items():
+        slowest = min(r[0] for r in runs)
+        fitted, tried = [], 0
+        for rate, row, guess in runs:
+            _, env, _, record = loaded[row["run_id"]]
+            if rate <= 1.1 * slowest and record is not None:
+                tried += 1
+                out = modal_properties(env, row, rate_hz_per_s=rate, record=record, mode_hz=guess, coil="fit", **kw)
+                if np.isfinite(out.get("coil_w_e_rad_s", np.nan)):
+                    fitted.append((row["run_id"], out["coil_w_e_rad_s"], out["coil_g_per_s2"]))
+        held = 2 * len(fitted) > tried
+        coils[key] = tuple(float(np.median([f[i] for f in fitted])) for i in (1, 2)) if held else None
+        if held:
+            notes.append(f"{runs[0][1]['assembly']} ({key}): the coil w_e {coils[key][0]:.6g} rad/s, g "
+                         f"{coils[key][1]:.6g} 1/s^2 fitted on {', '.join(str(f[0]) for f in fitted)}, held for "
+                         f"its {len(runs)} runs")
+    return coils
 
 
 def _independent_lines(tab: pd.DataFrame, loaded: tuple) -> pd.DataFrame:

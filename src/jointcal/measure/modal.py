@@ -71,7 +71,7 @@ FLAG_WORDS = {
 def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass_lbf: float = 2.65,
                      eta_max: float = 0.5, eta_frf: float = 4.0, snr_min_db: float = 20.0, frf_span: float = 2.0,
                      frf_misfit: float = 0.02, sweep_misfit: float = 0.1, mode_hz: float | None = None,
-                     record: pd.DataFrame | None = None, with_frf: bool = False):
+                     record: pd.DataFrame | None = None, with_frf: bool = False, coil=None):
     """Resonance, damping, amplitudes and flags of one run (one row of modal_properties.csv).
 
     Parameters
@@ -114,6 +114,9 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
         The raw record, for the whole-record FRF (`jointcal.measure.frf`) and the swept-mode fit.
     with_frf : bool
         Also return the FRF table (H1, H2, coherence, fitted displacement ratio).
+    coil : 'fit', (w_e, g) or None
+        A voltage drive's coil in the swept-mode fit (`jointcal.measure.sweepfit.fit_swept_mode`): fitted,
+        held at its corner (rad/s) and back-EMF gain (1/s^2), or left out; ignored for other drives.
 
     Returns
     -------
@@ -137,7 +140,7 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
         read = _base_readout(env_out, fit, flags, eta, rate_hz_per_s, eta_frf, frf_misfit)
         sweep = None
     else:
-        sweep, why = sweep_estimate(record, row, kind, fit, env_out, z_bb, band, sweep_misfit)
+        sweep, why = sweep_estimate(record, row, kind, fit, env_out, z_bb, band, sweep_misfit, coil)
         read = excited_readout(env_out, fit, sweep, why, flags, kind, f_bb, z_bb, rate_hz_per_s, eta_max,
                                frf_misfit, mass_lbf, record, row)
     out = _table_row(row, kind, env_out, read, read.get("eta", eta), eta_max, flags)
@@ -145,6 +148,7 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
                zeta_frf=fit.zeta if fit else np.nan, f_backbone_hz=float(f_bb), zeta_backbone=float(z_bb),
                f_sweep_hz=sweep.f_hz if sweep else np.nan, zeta_sweep=sweep.zeta if sweep else np.nan,
                sweep_residual=sweep.residual if sweep else np.nan, **modal_constant(sweep),
+               **({"coil_w_e_rad_s": sweep.coil[0], "coil_g_per_s2": sweep.coil[1]} if sweep and sweep.coil else {}),
                frf_residual=fit.residual if fit else np.nan, frf_truncated=fit.truncated if fit else np.nan,
                flags=";".join(dict.fromkeys(flags)))
     return (out, tab) if with_frf else out

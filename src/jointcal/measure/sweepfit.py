@@ -63,6 +63,14 @@ that begins with the mode already moving (cut from a longer run, or the drive on
 recording) contradicts that: where the fit from rest misses the response there by more than
 `quiet` of its peak, the run is fitted again from a low-pass reach into the record, from a start
 state fitted with the mode, and that fit is kept where the information criterion asks for it.
+
+An amplifier voltage drives the mode through the shaker's coil, whose corner R / L can sit near the
+mode (0.74 of it on the Ministack rig): its back-EMF damping then falls across the resonance, which
+A(w)'s slope only approximates. With `coil` the run is refitted with the coil as it is built
+(`jointcal.measure._coil`: the coil current a third state, its corner w_e and back-EMF gain g;
+`jointcal.measure._coil_fit`): the two fitted (`coil='fit'`, kept where the information criterion
+asks for them), or a campaign's held (`jointcal.measure.campaign.assembly_coil`: fitted on its
+slowest sweeps, where one fast chirp barely identifies them); f_hz and zeta are then the coupled pole's.
 """
 from __future__ import annotations
 
@@ -72,6 +80,8 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from ._coil import coil_pole
+from ._coil_fit import refit_with_coil
 from ._rotating import baseband, demodulate, head_end, passage
 from ._sweep_problem import Problem, earned_terms, fit_from_starts
 
@@ -102,6 +112,9 @@ class SweepFit:
     start_fitted : the record began with the mode already moving (the fit from rest missed the
         response at the record's start by more than `quiet` of its peak), and the fit kept is the one
         from a fitted state a low-pass reach in.
+    coil : (w_e, g) or None
+        A voltage drive's coil in the fit: its corner R / L (rad/s) and back-EMF gain (1/s^2); f_hz, zeta
+        and `backbone` are then the pole of the mode with its coil, coef the mode's own.
     """
 
     f_hz: float
@@ -116,12 +129,19 @@ class SweepFit:
     fraction_bad: float = 0.0
     ringing_end: bool = False
     start_fitted: bool = False
+    coil: tuple | None = None
+
+    def coil_text(self) -> str:
+        """The coil's constants in words (empty without a coil)."""
+        return "" if self.coil is None else f"coil w_e {self.coil[0]:.6g} rad/s, g {self.coil[1]:.6g} 1/s^2"
 
     def backbone(self, q: NDArray) -> tuple[NDArray, NDArray]:
         """Natural frequency (Hz) and damping ratio at amplitudes q (in) (fitted over [q_low_in, q_in])."""
         w2r, dr, a1, a2, b1, b2, _, qr, l_lo, l_hi, a3 = self.coef
         L = np.clip(np.log(np.asarray(q, float) / qr), l_lo, l_hi)
         om = np.sqrt(w2r * np.exp(a1 * L + a2 * L**2 + a3 * L**3))
+        if self.coil is not None:  # the pole of the mode with its coil
+            return coil_pole(om**2, dr * np.exp(b1 * L + b2 * L**2), *self.coil)
         return om / (2 * np.pi), dr * np.exp(b1 * L + b2 * L**2) / (2 * om)  # at w = Omega
 
 
@@ -130,7 +150,8 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
                    steps_per_cycle: float = 6.0, quiet: float = 0.02, ridge: float = 0.01,
                    curv: float = 0.3, residual_ridge: float = 0.3,
                    frequency_curvature: str = "bic", earn: float = 1.5,
-                   jacobian: Literal["sensitivity", "2-point"] = "sensitivity") -> SweepFit:
+                   jacobian: Literal["sensitivity", "2-point"] = "sensitivity",
+                   coil: Literal["fit"] | tuple[float, float] | None = None) -> SweepFit:
     """Fit one amplitude-dependent mode to a swept run (see the module docstring).
 
     Parameters
@@ -179,6 +200,9 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
         (`jointcal.measure._rotating_sensitivity`; one integration with its derivatives per Jacobian), or
         scipy's forward differences (one integration per free parameter; the earlier scheme, kept to
         compare with).
+    coil : 'fit', (w_e, g) or None
+        A voltage drive's coil (module docstring): fitted, held at its corner w_e (rad/s) and back-EMF
+        gain g (1/s^2), or left out (default: A(w)'s slope stands for it).
     residual_ridge : float
         The residual terms' share of that penalty (0.3: other modes' lines must be free enough to
         follow a second mode's stiffness line over the band, whose curvature biased the resonance
@@ -210,13 +234,15 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
         best = fit_from_starts(prob, free, f0, zeta0)
         return (prob, *earned_terms(prob, best, free, frequency_curvature, earn))
 
-    rest = fit(False)
-    if not _starts_moving(*rest, quiet):
-        return _result(*rest)
-    moving = fit(True)  # the record began with the mode already moving: its start state fitted
-    n_eff = moving[0].n_res / 2
-    ratio = (rest[0].relative(rest[1]) / moving[0].relative(moving[1])) ** 2  # the misfits' sums of squares
-    return _result(*(moving if n_eff * np.log(ratio) > 4 * np.log(n_eff) else rest))
+    if coil is not None and not (coil == "fit" or len(coil) == 2 and coil[0] > 0 and coil[1] >= 0):
+        raise ValueError(f"coil must be 'fit', (w_e > 0, g >= 0) or None, not {coil!r}.")
+    chosen = rest = fit(False)
+    if _starts_moving(*rest, quiet):
+        moving = fit(True)  # the record began with the mode already moving: its start state fitted
+        n_eff = moving[0].n_res / 2
+        ratio = (rest[0].relative(rest[1]) / moving[0].relative(moving[1])) ** 2  # the misfits' sums of squares
+        chosen = moving if n_eff * np.log(ratio) > 4 * np.log(n_eff) else rest
+    return _result(*(chosen if coil is None else refit_with_coil(*chosen, coil)))
 
 
 def _starts_moving(prob: Problem, best, free: NDArray, quiet: float) -> bool:
@@ -235,6 +261,7 @@ def _result(prob: Problem, best, free: NDArray) -> SweepFit:
     """The fit's resonance and damping at the largest amplitude its response reached, and its backbone."""
     mode, _ = prob.params(best.x, free)
     Z, _ = prob.response(best.x, free)
+    coil = None if prob.coil is None else (float(mode[12]), float(mode[13]))
     # over the whole window: a bad stretch at the peak leaves the misfit, not the amplitude reached
     win = prob.ps.inside
     q_top = float(np.abs(Z[win]).max())
@@ -242,6 +269,6 @@ def _result(prob: Problem, best, free: NDArray) -> SweepFit:
     fit = SweepFit(f_hz=np.nan, zeta=np.nan, q_in=q_top, q_low_in=float(np.abs(Z[win]).min()),
                    residual=prob.relative(best), coef=coef, modal_constant=complex(mode[6], mode[7]),
                    modal_slope=complex(mode[9], mode[10]), w0=prob.ps.sig.W0, fraction_bad=prob.ps.fraction_bad,
-                   ringing_end=prob.ps.ringing_end, start_fitted=prob.ps.free_start)
+                   ringing_end=prob.ps.ringing_end, start_fitted=prob.ps.free_start, coil=coil)
     f, z = fit.backbone(q_top)
     return SweepFit(**{**fit.__dict__, "f_hz": float(f), "zeta": float(z)})
