@@ -242,3 +242,23 @@ def test_force_driven_remote_sensor_gives_the_mode_at_its_own_amplitude(tmp_path
     assert remote["zeta_res"] == pytest.approx(float(z_t), rel=0.05)
     assert remote["modal_constant_re"] == pytest.approx(0.02 / model.m, rel=0.03)
     assert remote["q_in"] / 0.02 == pytest.approx(driving["q_in"], rel=0.03)
+
+def test_a_run_is_read_with_the_config_modal_section_as_the_later_stages_pass_it(tmp_path):
+    """Validation and discrepancy read one run at a time with the config's whole `modal` section
+    (measure_run): its campaign-level switches (coil, on or off) do not reach the one-run read-out, which
+    gives the same numbers as without them."""
+    import yaml
+    from _campaign import REPO, voltage_campaign
+
+    from jointcal.io import read_manifest, read_run
+    from jointcal.measure.modal import measure_run
+
+    folder = voltage_campaign(tmp_path / "v")
+    row = read_manifest(folder / "manifest.csv").iloc[0].to_dict()
+    record = read_run(folder / row["file"], row)
+    section = yaml.safe_load((REPO / "workflow" / "config" / "config.yaml").read_text())["modal"]
+    plain = measure_run(record, row)[2]
+    for coil in (False, True):
+        props = measure_run(record, row, modal_kw={**section, "coil": coil})[2]
+        assert props["f_res_method"] == plain["f_res_method"] == "sweep_fit"
+        assert props["f_res_hz"] == plain["f_res_hz"] and props["zeta_res"] == plain["zeta_res"]

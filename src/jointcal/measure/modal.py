@@ -251,7 +251,9 @@ def measure_run(record: pd.DataFrame, row: dict, *, envelopes_kw: dict | None = 
         Its manifest row.
     envelopes_kw, modal_kw : dict, optional
         Keyword options of `jointcal.measure.envelopes.envelopes` and `modal_properties` (the
-        config's ``envelopes`` and ``modal`` sections).
+        config's ``envelopes`` and ``modal`` sections; the section's ``coil`` switch, which
+        `jointcal.measure.campaign` acts on across a campaign's runs, is left out: one run is read
+        without a coil).
 
     Returns
     -------
@@ -267,7 +269,10 @@ def measure_run(record: pd.DataFrame, row: dict, *, envelopes_kw: dict | None = 
         rate = meta.rate_hz_per_s
     except ValueError:  # a chirp too short for the envelope window: the FRF path alone
         env, meta, rate = pd.DataFrame(columns=ENVELOPE_COLUMNS), None, float(row["sweep_rate_hz_per_s"])
-    props = modal_properties(env, row, rate_hz_per_s=rate, record=record, **(modal_kw or {}))
+    kw = dict(modal_kw or {})
+    if isinstance(kw.get("coil"), bool):  # the config's switch: the campaign's (measure.campaign), not one run's
+        kw.pop("coil")
+    props = modal_properties(env, row, rate_hz_per_s=rate, record=record, **kw)
     return env, meta, props
 
 
