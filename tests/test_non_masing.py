@@ -117,3 +117,24 @@ def test_a_joint_softening_more_than_masing_allows_gets_a_no_and_a_masing_joint_
     assert fit["fit_p"] < P_REJECT and "are rejected by" in a1  # the No comes from the chi-square it shows
     answer, fit, a1 = _verdict(tmp_path / "masing", 0.0)
     assert fit["fit_p"] >= P_REJECT and "agree with" in a1 and "are rejected by" not in a1
+
+
+@pytest.mark.parametrize("s", [0.3, 0.7])
+@pytest.mark.parametrize("q", [1e-3, 8e-3, 0.03, 0.08])  # microslip, near and past macroslip (phi_max 0.0498 in)
+def test_the_envelope_model_has_the_blended_joints_describing_function(s, q):
+    """The envelope kernel's describing function of the backbone share (1 - s) K_iwan + s k_b, read back from a
+    steady state on a rigid base, (K_z - m w^2) Z = -m A, against the force law integrated over a cycle."""
+    from jointcal.models import steady_state
+    from jointcal.models.elements import backbone_share
+
+    m, k = 1 / G, 818.0
+    model = MinistackModel(m=m, k=k, zeta_v=0.0, iwan=P, elements=(backbone_share(s),))
+    k1, D = first_harmonic(q, P, s, n=20000)
+    f = np.sqrt((k + k1) / m) / (2 * np.pi) * 0.9  # below resonance: one stable branch
+    A = q * abs(k + k1 - m * (2 * np.pi * f) ** 2) / m / G  # base amplitude (g) that gives about q there
+    st = steady_state(model, [f], A)
+    qq, Z = float(st.q_in[0]), complex(st.relative[0])
+    Kz = m * (2 * np.pi * f) ** 2 - m * A * G / Z
+    k1q, Dq = first_harmonic(qq, P, s, n=20000)
+    assert Kz.real - k == pytest.approx(k1q, rel=2e-4)
+    assert Kz.imag == pytest.approx(Dq / (np.pi * qq**2), rel=2e-4)

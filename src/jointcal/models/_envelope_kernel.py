@@ -74,6 +74,32 @@ def _quadratic_damper(q, w, a, im, dim, C, C1):
     return im + t, dim + t, C + 16.0 * a * w * q / (3.0 * PI), C1 + 16.0 * a * q / (3.0 * PI)
 
 
+@njit(cache=True)
+def _backbone_first_harmonic(q, KT, R, chi, phimax, nodes, weights):
+    """First-harmonic stiffness k_b (lbf/in) of the Iwan joint's virgin backbone F_b taken as an elastic
+    spring, at amplitude q (in), and its slope dk_b / dlog q.
+
+    k_b = (4 / (pi q)) I, I = int_0^{pi/2} F_b(q cos t) cos t dt with F_b = KT z - R' z^n (n = chi + 2,
+    R' = R / ((chi + 1)(chi + 2))) below phi_max and Fs beyond (`iwan.backbone`). With t_c = arccos(phi_max / q)
+    (0 in microslip), I = Fs sin t_c + KT q (pi/4 - t_c/2 - sin(2 t_c)/4) - R' q^n M, M = int_{t_c}^{pi/2}
+    cos^{n+1} t dt (Gauss-Legendre on the nodes). F_b is continuous at t_c, so the t_c-terms of dI/dq
+    cancel: dI/dq = KT (pi/4 - t_c/2 - sin(2 t_c)/4) - n R' q^{n-1} M, and dk_b/dlog q = (4/pi)(dI/dq - I/q).
+    """
+    n = chi + 2.0
+    Rp = R / ((chi + 1.0) * (chi + 2.0))
+    tc = 0.0 if q <= phimax else np.arccos(phimax / q)
+    M = 0.0
+    for i in range(nodes.shape[0]):
+        t = tc + (0.5 * PI - tc) * nodes[i]
+        M += weights[i] * np.cos(t) ** (n + 1.0)
+    M *= 0.5 * PI - tc
+    lin = 0.25 * PI - 0.5 * tc - 0.25 * np.sin(2.0 * tc)
+    Fs = KT * phimax - Rp * phimax**n  # the backbone at phi_max
+    I = Fs * np.sin(tc) + KT * q * lin - Rp * q**n * M
+    dI = KT * lin - n * Rp * q ** (n - 1.0) * M
+    return 4.0 * I / (PI * q), 4.0 * (dI - I / q) / PI
+
+
 @njit(cache=True, inline="always")
 def _stiffness(q, s, w, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes, weights):
     """Complex dynamic stiffness of the joint DOF at amplitude q (in) and omega w (rad/s).
@@ -82,7 +108,7 @@ def _stiffness(q, s, w, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes, w
     fixed q (lbf s/in), C1 = dC/domega. kp: linear springs in parallel (k); c: dashpot; Iwan (KT, R, chi,
     phimax, S; J1 = J(chi, 1)); codes (n_e,), coefs (n_e, 2): the element table (`models.elements`).
     """
-    re, im, dre, dim = kp, w * c, 0.0, 0.0
+    re, im, dre, dim = 0.0, 0.0, 0.0, 0.0  # the Iwan joint's own part first (a backbone share scales it)
     if KT > 0.0:
         e = chi + 1.0
         if q <= phimax:
@@ -109,6 +135,13 @@ def _stiffness(q, s, w, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes, w
             dD = 4.0 * R * u ** (chi + 2.0) / (chi + 2.0) + 4.0 * S * phimax  # dD/dq
             im += D / (PI * q * q)
             dim += (q * dD - 2.0 * D) / (PI * q * q)
+    for i in range(codes.shape[0]):  # a backbone share: (1 - s) of the Iwan joint + s of its elastic backbone
+        if codes[i] == 4 and KT > 0.0:
+            kb, dkb = _backbone_first_harmonic(q, KT, R, chi, phimax, nodes, weights)
+            sh = coefs[i, 0]
+            re, im, dre, dim = (1.0 - sh) * re + sh * kb, (1.0 - sh) * im, (1.0 - sh) * dre + sh * dkb, (1.0 - sh) * dim
+    re += kp
+    im += w * c
     C, C1 = c, 0.0  # dIm/domega at fixed q, and its own omega-slope
     for i in range(codes.shape[0]):  # the element table: one inline function per kind
         if codes[i] == 1:  # cubic spring

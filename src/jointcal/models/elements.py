@@ -18,9 +18,11 @@ backbone share      4     -a (F_iwan - F_b(z))       share s, [0, 1)       (unus
 The table is sorted by code: the kernels evaluate the velocity-dependent elements last
 (their force enters the acceleration their tangent needs). The contact spring has no
 first-harmonic model (a mean offset, even harmonics): only the time simulation takes it.
-The backbone share (the virtual lab's non-Masing joint, `jointcal.synth.non_masing`) makes
-the exact Iwan joint's force (1 - s) F_iwan(history) + s F_b(z), F_b its virgin backbone:
-the same backbone, (1 - s) of the dissipation; only the time simulation takes it too.
+The backbone share (a non-Masing joint: `jointcal.synth.non_masing`, the effect
+`jointcal.effects.elastic_softening`) makes the exact Iwan joint's force
+(1 - s) F_iwan(history) + s F_b(z), F_b its virgin backbone: the same backbone, (1 - s) of
+the dissipation. The envelope kernel's describing function is (1 - s) K_iwan(q) + s k_b(q),
+k_b the backbone's first-harmonic stiffness (`_envelope_kernel._backbone_first_harmonic`).
 """
 from __future__ import annotations
 
@@ -39,7 +41,7 @@ QUADRATIC_DAMPER = 3
 BACKBONE_SHARE = 4
 NAMES = {CUBIC_SPRING: "cubic spring", CONTACT_SPRING: "contact spring", QUADRATIC_DAMPER: "quadratic damper",
          BACKBONE_SHARE: "backbone share"}
-FIRST_HARMONIC = frozenset({CUBIC_SPRING, QUADRATIC_DAMPER})  # the envelope kernel has their describing functions
+FIRST_HARMONIC = frozenset({CUBIC_SPRING, QUADRATIC_DAMPER, BACKBONE_SHARE})  # the envelope kernel has their describing functions
 
 
 @dataclass(frozen=True)
