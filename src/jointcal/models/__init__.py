@@ -3,7 +3,7 @@ from .amplitude import G, harmonic_balance, jenkins_inphase, qsma, resonance_amp
 from .iwan import IwanParams, backbone, backbone_stiffness, derived, dissipation, force_history
 from .elements import Element, contact_spring, cubic_spring, quadratic_damper
 from .simulate import SimResult, fractional_delay, integrate, simulate
-from .structure import Fixture, MinistackModel, state_space
+from .structure import Fixture, MinistackModel, Neighbour, state_space
 from .envelope import SteadyState, steady_state
 from .swept import SweepDrive, quasi_steady
 from .swept_integrated import swept_transmissibility
@@ -11,7 +11,7 @@ from .swept_integrated import swept_transmissibility
 __all__ = [
     "G", "IwanParams", "derived", "backbone", "backbone_stiffness", "dissipation", "force_history",
     "qsma", "harmonic_balance", "jenkins_inphase", "resonance_amplitude",
-    "MinistackModel", "Fixture", "SteadyState", "steady_state", "SweepDrive", "quasi_steady", "swept_transmissibility",
+    "MinistackModel", "Fixture", "Neighbour", "SteadyState", "steady_state", "SweepDrive", "quasi_steady", "swept_transmissibility",
     "state_space", "simulate", "integrate", "SimResult", "fractional_delay",
     "Element", "cubic_spring", "quadratic_damper", "contact_spring",
 ]

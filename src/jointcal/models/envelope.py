@@ -37,7 +37,7 @@ from ..units import G
 from .amplitude import _J
 from .elements import FIRST_HARMONIC, NAMES, element_table
 from .iwan import derived
-from .structure import MinistackModel
+from .structure import MinistackModel, Neighbour
 
 __all__ = ["SteadyState", "steady_state"]
 
@@ -242,5 +242,9 @@ def steady_state(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike = 1.0
         a11 = k_can + 1j * w * c_can - w**2 * (m_can + m[:, None])
         W = (-(m_can + m[:, None]) * A + w**2 * m[:, None] * Z) / a11  # can row: a11 W - omega^2 m Z = -(m_can+m) A
         T = gain[:, None] * (1.0 - w**2 * (W + Z) / A) * np.exp(-1j * w * tau[:, None])
+    nb = model.neighbour
+    if nb is not None:  # a neighbouring linear mode the response channel also reads (`structure.Neighbour`)
+        T = T + gain[:, None] * np.exp(-1j * w * tau[:, None]) * Neighbour(
+            _field(nb.f_hz, shape)[:, None], _field(nb.ratio, shape)[:, None], _field(nb.zeta, shape)[:, None]).frf(f)
     return SteadyState(T.reshape(out_shape), Z.reshape(out_shape), q.reshape(out_shape), jump.reshape(out_shape))
 

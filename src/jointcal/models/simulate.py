@@ -24,7 +24,7 @@ from ..units import G
 from ._masing import kernel_constants
 from .elements import CONTACT_SPRING, Element, element_table
 from .iwan import IwanParams, derived
-from .structure import MinistackModel, StateSpace, state_space
+from .structure import MinistackModel, Neighbour, StateSpace, state_space
 
 __all__ = ["SimResult", "simulate", "integrate", "hermite_propagator", "fractional_delay", "substeps",
            "band_limited"]
@@ -167,7 +167,7 @@ def simulate(model: MinistackModel, base_accel_g: ArrayLike, fs: float, *,
         raise ValueError("simulate: base_accel_g holds NaN or inf; clean or trim the record first.")
     if not fs > 0:
         raise ValueError(f"simulate: sample rate must be positive, got {fs!r}.")
-    n_out = u.size
+    n_out, u_in = u.size, u
     U = 1
     if samples_per_cycle is not None:
         u, U = band_limited(u, fs, model.f0_hz, samples_per_cycle)
@@ -177,10 +177,24 @@ def simulate(model: MinistackModel, base_accel_g: ArrayLike, fs: float, *,
     y = Y[0]
     if U > 1:
         y, z, fs = y[::U][:n_out].copy(), z[::U][:n_out].copy(), fs / U
+    if model.neighbour is not None:
+        y = y + neighbour_response(model.neighbour, u_in, fs)
     if model.sensor_delay_s != 0.0:
         y = fractional_delay(y, model.sensor_delay_s, fs)
     y *= model.sensor_gain / G
     return SimResult(response_g=y, z_in=z, n_sub=n_sub * U)
+
+
+def neighbour_response(nb: Neighbour, u: NDArray, fs: float) -> NDArray[np.float64]:
+    """Relative acceleration of a neighbouring linear mode (`structure.Neighbour`) driven by the base
+    acceleration u (any unit; the same out), sampled at fs (Hz).
+
+    Applied line by line to the record's spectrum (zero-padded to twice its length, so the mode's ringing
+    does not wrap): exact for the band-limited record a DAQ takes, as the drive's gain is applied
+    (`jointcal.validate.drive`).
+    """
+    n = 1 << int(np.ceil(np.log2(2 * u.size)))
+    return np.fft.irfft(np.fft.rfft(u, n) * nb.frf(np.fft.rfftfreq(n, 1.0 / fs)), n)[:u.size]
 
 
 def _joint(iwan: IwanParams | None, sliders: tuple[NDArray, NDArray] | None):

@@ -24,11 +24,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .elements import Element
 from .iwan import IwanParams
 
-__all__ = ["Fixture", "MinistackModel", "StateSpace", "state_space"]
+__all__ = ["Neighbour", "Fixture", "MinistackModel", "StateSpace", "state_space"]
 
 
 @dataclass(frozen=True)
@@ -42,6 +43,34 @@ class Fixture:
     m_can: float
     f_can: float
     zeta_can: float = 0.01
+
+
+@dataclass(frozen=True)
+class Neighbour:
+    """A linear mode beside the modelled one that the response channel also sees, driven by the same input.
+
+    Its relative acceleration per unit base acceleration is ``ratio`` w^2 / (w_n^2 - w^2 + 2 i zeta w_n w),
+    w_n = 2 pi ``f_hz``: the modelled mode's own form with ``ratio`` times its modal constant (a residual
+    mode above the band reads as a mass line, one below as a stiffness line). Fields may be batched (P, 1).
+
+    Parameters
+    ----------
+    f_hz : float
+        Its natural frequency, Hz.
+    ratio : float
+        Its modal constant over the modelled mode's (signed, -).
+    zeta : float
+        Its damping ratio.
+    """
+
+    f_hz: float
+    ratio: float
+    zeta: float = 0.01
+
+    def frf(self, f: NDArray) -> NDArray[np.complex128]:
+        """Relative acceleration over base acceleration at frequencies f (Hz), shape broadcast(fields, f)."""
+        wn, w = 2 * np.pi * np.asarray(self.f_hz, float), 2 * np.pi * np.asarray(f, float)
+        return np.asarray(self.ratio, float) * w**2 / (wn**2 - w**2 + 2j * np.asarray(self.zeta, float) * wn * w)
 
 
 @dataclass(frozen=True)
@@ -69,6 +98,8 @@ class MinistackModel:
         Response-channel sensitivity error factor (``sensor_gain``).
     sensor_delay_s : float
         Response-channel delay, s (``channel_delay``).
+    neighbour : Neighbour or None
+        A linear mode beside this one that the response channel also sees (``neighbour_mode``).
     """
 
     m: float
@@ -79,6 +110,7 @@ class MinistackModel:
     elements: tuple[Element, ...] = ()
     sensor_gain: float = 1.0
     sensor_delay_s: float = 0.0
+    neighbour: Neighbour | None = None
 
     def __post_init__(self) -> None:
         for name in ("m", "k"):

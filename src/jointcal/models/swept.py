@@ -61,7 +61,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import _envelope_kernel as _k
 from ..units import G
 from .envelope import _NODES, _WEIGHTS, _amplitudes, _batch_shape, _field, _joint_terms
-from .structure import MinistackModel
+from .structure import MinistackModel, Neighbour
 
 __all__ = ["SweepDrive", "quasi_steady", "quasi_steady_runs", "sweep_eta", "CAP"]
 
@@ -215,6 +215,16 @@ def _sensor(model: MinistackModel, f: NDArray, shape) -> NDArray:
     return gain * np.exp(-2j * np.pi * f * tau)
 
 
+def _channel(model: MinistackModel, T: NDArray, f: NDArray, shape) -> NDArray:
+    """What the response channel reads of the joint DOF's T (P, N): a neighbouring mode added (linear, steady),
+    then the sensor's gain and delay."""
+    nb = model.neighbour
+    if nb is not None:
+        T = T + Neighbour(_field(nb.f_hz, shape)[:, None], _field(nb.ratio, shape)[:, None],
+                          _field(nb.zeta, shape)[:, None]).frf(f)
+    return T * _sensor(model, f, shape)
+
+
 def quasi_steady(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike = 1.0, *,
                  rate_hz_per_s: ArrayLike = 0.0, dlog_base_per_s: ArrayLike = 0.0,
                  direction: Literal["up", "down"] = "up") -> NDArray[np.complex128]:
@@ -244,7 +254,7 @@ def quasi_steady(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike = 1.0
     shape, out_shape = _batch_shape(model, f.shape)
     R, _, A = _quasi_steady(model, f, np.broadcast_to(np.asarray(base_g, float), f.shape),
                             rate_hz_per_s, dlog_base_per_s, direction)
-    return (R / A * _sensor(model, f, shape)).reshape(out_shape)
+    return _channel(model, R / A, f, shape).reshape(out_shape)
 
 
 def quasi_steady_runs(model: MinistackModel, runs: Sequence[tuple]) -> list[NDArray[np.complex128]]:
@@ -262,5 +272,5 @@ def quasi_steady_runs(model: MinistackModel, runs: Sequence[tuple]) -> list[NDAr
                         for i in (1, 2, 3))
     shape, out_shape = _batch_shape(model, f_all.shape)
     R, _, A = _quasi_steady(model, f_all, base, rate, dlog, "up", segments=segments)
-    T = (R / A * _sensor(model, f_all, shape)).reshape(out_shape)
+    T = _channel(model, R / A, f_all, shape).reshape(out_shape)
     return [T[..., a:b] for a, b, _ in segments]

@@ -15,7 +15,7 @@ from . import _envelope_kernel as _k
 from ..units import G
 from .envelope import _NODES, _WEIGHTS, _field, _joint_terms
 from .structure import MinistackModel
-from .swept import SweepDrive, _derivs, _quasi_steady, _sensor, sweep_eta
+from .swept import SweepDrive, _channel, _derivs, _quasi_steady, sweep_eta
 
 __all__ = ["swept_transmissibility", "ETA_MIN", "SPAN"]
 
@@ -72,7 +72,7 @@ def swept_transmissibility(model: MinistackModel, drive: SweepDrive, t_s: ArrayL
         if keep.any():
             T[keep] = _integrated(model, drive, t_a, t_b, ka, t_out[keep], direction,
                                   2 * np.pi * f_res_hz * zeta, max(span, after))
-    return T * _sensor(model, f_o, (1, t_out.size))[0]
+    return _channel(model, T[None], f_o, (1, t_out.size))[0]
 
 
 def _integrated(model: MinistackModel, drive: SweepDrive, t_a: float, t_b: float, ka: int, t_out: NDArray,

@@ -16,7 +16,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from ..io._contract import REFERENCE
-from ..models import MinistackModel, simulate
+from ..models import MinistackModel, fractional_delay, simulate
 from ..units import G
 
 __all__ = ["reference_column", "clean_base", "drive_gain", "model_input", "simulate_record"]
@@ -95,8 +95,10 @@ def simulate_record(model: MinistackModel, record: pd.DataFrame, row: Mapping) -
     """
     a_b, col = model_input(record, row)
     y = simulate(model, a_b, float(row["sample_rate_hz"])).response_g
-    if col != REFERENCE["base"]:
-        y = y - a_b  # a fixed base forced by -m a_b: the mass's acceleration is the relative one
+    if col != REFERENCE["base"]:  # a fixed base forced by -m a_b: the mass's acceleration is the relative one,
+        # read through the same sensor gain and delay as the simulated channel
+        fs = float(row["sample_rate_hz"])
+        y = y - model.sensor_gain * (fractional_delay(a_b, model.sensor_delay_s, fs) if model.sensor_delay_s else a_b)
     y[~np.isfinite(record[col].to_numpy(dtype=float))] = np.nan
     out = record[["time_s", col]].copy()
     out["response_accel_g"] = y
