@@ -142,7 +142,7 @@ def verdict_inputs(wildcards):
     out = {}
     if has_rule("validate_assembly"):
         out["validation"] = [str(VALIDATION / a / m / "summary.json") for a, m in units()]
-    if has_rule("discrepancy_assembly") and EXCITATION == "base":
+    if has_rule("discrepancy_assembly"):
         out["diagnosis"] = [str(DISCREPANCY / a / m / "diagnosis.json") for a, m in units()]
     if has_rule("design_assembly"):
         out["design"] = [str(DESIGN / a / m / "next_test.json") for a, m in units()]

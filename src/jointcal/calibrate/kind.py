@@ -29,8 +29,9 @@ import numpy as np
 import pandas as pd
 
 from ..io._contract import LEVEL, excitation_kind
+from ..models import harmonic_balance
 
-__all__ = ["KINDS", "Kind", "excitation_of_table", "kind_of", "data_bounds", "model_words"]
+__all__ = ["KINDS", "Kind", "excitation_of_table", "kind_of", "data_bounds", "model_words", "backbone_at"]
 
 Kind = Literal["ministack", "modal"]
 KINDS: tuple[str, ...] = ("auto", "ministack", "modal")
@@ -99,3 +100,11 @@ def model_words(best: Mapping) -> str:
     return (f"One mode of the structure ({exc}-driven): a modal mass on the spring k in parallel with the Iwan "
             f"joint (Fs, KT, chi, beta) and a dashpot (zeta_v), {mass}; q is the mode's displacement amplitude "
             f"at the response sensor, the largest the run reached.{rig} The bounds came from the data.")
+
+
+def backbone_at(joint: Mapping[str, float], m: float, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Frequency (Hz) and damping ratio of either kind at amplitudes q (in): the harmonic balance of the mass m
+    on k, the Iwan joint (Fs, KT, chi, beta) and the dashpot zeta_v (eqs. 3.1-3.7; `models.harmonic_balance`)."""
+    f, z = harmonic_balance(np.asarray(q, float), joint["Fs"], joint["KT"], joint["chi"], joint["beta"], joint["k"],
+                            m, joint["zeta_v"])
+    return np.asarray(f, float), np.asarray(z, float)

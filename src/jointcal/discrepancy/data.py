@@ -22,7 +22,10 @@ from numpy.typing import NDArray
 from ..models import SweepDrive
 from ..measure.envelopes import window_length
 from ..measure.peaks import full_drive, transmissibility
+from ..io import level_column
+from ..validate.drive import equivalent_base
 from ..validate.error import BINS
+from ..validate.runs import full_drive_fraction
 
 __all__ = ["RunEnvelope", "run_envelope", "run_zeta", "scale_arrays"]
 
@@ -31,9 +34,13 @@ __all__ = ["RunEnvelope", "run_envelope", "run_zeta", "scale_arrays"]
 class RunEnvelope:
     """One run's measured envelope frames (all arrays shape (n,)).
 
-    f_hz : drive frequency, Hz; base_g : base amplitude, g; T : measured transmissibility;
+    f_hz : drive frequency, Hz; base_g : base amplitude, g (a force or voltage drive: the equivalent
+    base amplitude |A(w)| |r| / G, `jointcal.validate.drive.equivalent_base`); T : measured response over
+    reference (g/g, g/lbf or g/V); level : the run's level in its own unit (g, lbf or V);
+    equivalent_base : -A(w) / G per frame for a force or voltage drive (None for a base drive): the
+    model's response channel reads equivalent_base (T_model - s), s the sensor (`fit.observed`);
     sigma_db, sigma_deg : repeat scatter of magnitude and phase at each frame; rate : signed
-    sweep rate df/dt, Hz/s; row : the manifest/modal row (run_id, level_g, direction,
+    sweep rate df/dt, Hz/s; row : the manifest/modal row (run_id, its level, direction,
     sequence, f_res_hz, zeta_phase_resonance, ...); t_s : frame times, s; drive : the run's
     measured drive (None: frames taken as a constant-rate sweep, no transient integrated);
     transient : the sweep transient's factor on the first-order envelope at the frames
@@ -50,6 +57,8 @@ class RunEnvelope:
     t_s: NDArray[np.float64] | None = None
     drive: SweepDrive | None = None
     transient: NDArray[np.complex128] | None = None
+    level: float = float("nan")
+    equivalent_base: NDArray[np.complex128] | None = None
 
     @cached_property
     def drive_rates(self) -> tuple[NDArray, NDArray] | None:
@@ -113,9 +122,12 @@ def run_envelope(env: pd.DataFrame, row: Mapping, sigma_db: NDArray, sigma_deg: 
     zeta = run_zeta(row)
     if not (np.isfinite(f_res) and np.isfinite(zeta) and zeta > 0) or "unusable" in str(row.get("flags", "")):
         return None
-    ref = (env["ref_re"] + 1j * env["ref_im"]).to_numpy()
     f = env["f_drive_hz"].to_numpy(float)
-    ok = full_drive(env)
+    ref = (env["ref_re"] + 1j * env["ref_im"]).to_numpy()
+    eq = equivalent_base(row, f)
+    if eq is not None:  # a force or voltage: the model is driven by the equivalent base acceleration
+        ref = ref * eq
+    ok = full_drive(env, full_drive_fraction(row))
     ok &= (f >= band[0] * f_res) & (f <= band[1] * f_res)
     idx = np.flatnonzero(ok)
     if idx.size < 8:
@@ -129,5 +141,8 @@ def run_envelope(env: pd.DataFrame, row: Mapping, sigma_db: NDArray, sigma_deg: 
     ok_t = np.flatnonzero(ok)
     keep = ok_t[np.r_[True, np.diff(t[ok_t]) > 0]]
     drive = (SweepDrive(t[keep], f[keep], np.abs(ref[keep]), L) if L is not None and keep.size >= 4 else None)
+    col = level_column(row)
     return RunEnvelope(f_hz=f[idx], base_g=np.abs(ref[idx]), T=transmissibility(env)[idx], sigma_db=sigma_db[b],
-                       sigma_deg=sigma_deg[b], rate=rate, row=dict(row), t_s=t[idx], drive=drive)
+                       sigma_deg=sigma_deg[b], rate=rate, row=dict(row), t_s=t[idx], drive=drive,
+                       level=float(row[col]) if col else float("nan"),
+                       equivalent_base=None if eq is None else eq[idx])

@@ -32,6 +32,7 @@ import numpy as np
 import pandas as pd
 
 from ..effects import EFFECTS
+from ..io import level_column
 from .data import RunEnvelope
 from .fit import Candidate, predict
 
@@ -48,7 +49,7 @@ def residual_map(c: Candidate, theta, runs: Sequence[RunEnvelope]) -> pd.DataFra
         r = run.row
         f_res = float(r["f_res_hz"])
         rows.append(pd.DataFrame(dict(
-            run_id=r["run_id"], level=float(r.get("level_g", np.nan)), direction=r.get("direction", ""),
+            run_id=r["run_id"], level=run.level, direction=r.get("direction", ""),
             sequence=int(r.get("sequence", 0)), f_hz=run.f_hz, f_over_fres=run.f_hz / f_res,
             d_mag_db=20 * np.log10(np.abs(d)), d_phase_deg=np.degrees(np.angle(d)),
             z_mag=20 * np.log10(np.abs(d)) / run.sigma_db, z_phase=np.degrees(np.angle(d)) / run.sigma_deg)))
@@ -72,7 +73,7 @@ def fingerprints(res: pd.DataFrame, modal: pd.DataFrame, model_fz: Mapping[str, 
     res : DataFrame
         `residual_map` of the baseline.
     modal : DataFrame
-        The assembly's usable modal rows (run_id, level_g, sequence, f_res_hz,
+        The assembly's usable modal rows (run_id, its level column, sequence, f_res_hz,
         zeta_phase_resonance, h2_ratio, h3_ratio).
     model_fz : mapping run_id -> (f_hz, zeta)
         The baseline's harmonic-balance frequency and damping at each run's measured amplitude.
@@ -92,21 +93,22 @@ def fingerprints(res: pd.DataFrame, modal: pd.DataFrame, model_fz: Mapping[str, 
     mo = modal.copy()
     mo["f_mod"] = [model_fz[r][0] for r in mo["run_id"]]
     mo["z_mod"] = [model_fz[r][1] for r in mo["run_id"]]
-    lev = np.log10(mo["level_g"].astype(float))
+    col = level_column(mo.columns)
+    lev = np.log10(mo[col].astype(float))
     out["f_trend_per_decade"] = _slope(lev, mo["f_res_hz"] / mo["f_mod"] - 1)
     out["zeta_trend_per_decade"] = _slope(lev, mo["zeta_phase_resonance"] / mo["z_mod"] - 1)
-    counts = mo.groupby("level_g").size()
+    counts = mo.groupby(col).size()
     lv = counts.idxmax() if len(counts) else np.nan
-    rep = mo[mo["level_g"] == lv].sort_values("sequence")
+    rep = mo[mo[col] == lv].sort_values("sequence")
     if len(rep) >= 3 and scatter_f > 0:
         s = _slope(rep["sequence"], rep["f_res_hz"] / rep["f_res_hz"].mean())
         out["drift_sigma"] = float(s * np.ptp(rep["sequence"]) / scatter_f)
     else:
         out["drift_sigma"] = float("nan")
-    top = mo[mo["level_g"] == mo["level_g"].max()]
+    top = mo[mo[col] == mo[col].max()]
     out["h2_ratio"] = float(top["h2_ratio"].median()) if "h2_ratio" in top else np.nan
     out["h3_ratio"] = float(top["h3_ratio"].median()) if "h3_ratio" in top else np.nan
-    bot = mo[mo["level_g"] == mo["level_g"].min()]
+    bot = mo[mo[col] == mo[col].min()]
     chi = float(joint["chi"])
     f0 = np.sqrt((joint["k"] + joint["KT"]) / m) / (2 * np.pi)
     ratio = (bot["zeta_phase_resonance"] - joint["zeta_v"]) / (1 - bot["f_res_hz"] / f0)

@@ -35,7 +35,7 @@ from ..models.swept import quasi_steady_runs
 from .data import RunEnvelope, run_zeta
 from ..effects import EFFECTS, apply_effect, effects_of
 
-__all__ = ["HELD", "Candidate", "Fit", "candidate", "model_at", "fit_candidate", "envelope_E", "predict",
+__all__ = ["HELD", "Candidate", "Fit", "candidate", "model_at", "fit_candidate", "envelope_E", "observed", "predict",
            "with_transient"]
 
 HELD = ("beta",)  # joint parameters the envelopes barely constrain: held at the start's value by every fit
@@ -113,11 +113,26 @@ def _first_order(c: Candidate, theta: NDArray, run: RunEnvelope) -> NDArray[np.c
     return _first_order_runs(c, theta, [run])[0]
 
 
+def observed(model: MinistackModel, T: NDArray, run: RunEnvelope) -> NDArray[np.complex128]:
+    """What the run's response over reference reads of the model's base-rig envelope T, (P, n) or (n,).
+
+    A base drive: T itself. A force or voltage: the model is driven by the equivalent base
+    acceleration e R (e = -A(w) / G per frame, `RunEnvelope.equivalent_base`), and its response
+    channel reads the mode's relative acceleration through the sensor s (gain and delay): e (T - s).
+    """
+    if run.equivalent_base is None:
+        return T
+    gain = np.asarray(model.sensor_gain, dtype=float)
+    tau = np.asarray(model.sensor_delay_s, dtype=float)
+    return run.equivalent_base * (T - gain * np.exp(-2j * np.pi * run.f_hz * tau))
+
+
 def predict(c: Candidate, theta: NDArray, run: RunEnvelope) -> NDArray[np.complex128]:
-    """Model transmissibility at the run's frames as the sweep shows it, (P, n) or (n,): the first-order
-    envelope times the run's transient factor (see the module notes)."""
+    """The run's measured quantity as the model gives it at its frames as the sweep shows it, (P, n) or (n,):
+    the first-order envelope times the run's transient factor (see the module notes), `observed`."""
     T = _first_order(c, theta, run)
-    return T if run.transient is None else T * run.transient
+    T = T if run.transient is None else T * run.transient
+    return observed(model_at(c, theta, run.row), T, run)
 
 
 def with_transient(c: Candidate, theta: NDArray, runs: Sequence[RunEnvelope]) -> list[RunEnvelope]:
@@ -137,9 +152,9 @@ def with_transient(c: Candidate, theta: NDArray, runs: Sequence[RunEnvelope]) ->
     return out
 
 
-def _run_residual(T: NDArray, run: RunEnvelope, n_runs: int) -> NDArray:
+def _run_residual(model: MinistackModel, T: NDArray, run: RunEnvelope, n_runs: int) -> NDArray:
     """Weighted magnitude (dB) and phase (deg) errors of first-order envelope T at the run's frames."""
-    d = (T if run.transient is None else T * run.transient) / run.T
+    d = observed(model, T if run.transient is None else T * run.transient, run) / run.T
     w = 1.0 / np.sqrt(2.0 * run.f_hz.size * n_runs)
     dm = 20 * np.log10(np.abs(d)) / run.sigma_db
     dp = np.degrees(np.angle(d)) / run.sigma_deg
@@ -150,7 +165,8 @@ def residuals(c: Candidate, theta: NDArray, runs: Sequence[RunEnvelope]) -> NDAr
     """Residual vector whose sum of squares is E^2 (theta (n,) -> (m,), (P, n) -> (P, m))."""
     with np.errstate(all="ignore"):
         T = _first_order_runs(c, theta, runs)
-        r = np.concatenate([_run_residual(t, run, len(runs)) for t, run in zip(T, runs)], axis=-1)
+        model = model_at(c, theta, runs[0].row)  # its sensor (no effect changes it along the sequence)
+        r = np.concatenate([_run_residual(model, t, run, len(runs)) for t, run in zip(T, runs)], axis=-1)
     return np.where(np.isfinite(r), r, 1e3)
 
 

@@ -1,7 +1,7 @@
 """The fast model's own error: its envelope of the calibrated model against that model's time simulation.
 
 The validation stage simulates the calibrated model in time, driven by each run's measured
-base record, and measures the simulated record with the same envelopes (`jointcal.validate`).
+reference record, and measures the simulated record with the same envelopes (`jointcal.validate`).
 On those runs and frames (the compared band) the fast model (`fit.predict`: the swept
 envelope model) gives the same model's envelope; their difference, in the validation's
 definition of E (per-bin repeat scatter, every run weighted equally), is the floor below
@@ -18,6 +18,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from ..validate.drive import equivalent_base
 from ..validate.error import BINS
 from .data import RunEnvelope, run_zeta
 from .fit import Candidate, predict, with_transient
@@ -39,8 +40,10 @@ def _at_frames(run: RunEnvelope, frame: pd.DataFrame, sdb: NDArray, sdeg: NDArra
     T = 10 ** (fr["mag_sim_db"].to_numpy(float) / 20) * np.exp(1j * np.radians(fr["phase_sim_deg"].to_numpy(float)))
     x = np.abs(fr["f_hz"].to_numpy(float) / float(run.row["f_res_hz"]) - 1.0) / run_zeta(run.row)
     b = np.clip(np.digitize(x, BINS[1:-1]), 0, len(BINS) - 2)
-    return replace(run, f_hz=fr["f_hz"].to_numpy(float), base_g=base, T=T, sigma_db=sdb[b], sigma_deg=sdeg[b],
-                   t_s=t, transient=None)
+    f = fr["f_hz"].to_numpy(float)
+    eq = None if run.equivalent_base is None else equivalent_base(run.row, f)
+    return replace(run, f_hz=f, base_g=base, T=T, sigma_db=sdb[b], sigma_deg=sdeg[b], t_s=t, transient=None,
+                   equivalent_base=eq)
 
 
 def fast_floor(c: Candidate, theta: NDArray, runs: Sequence[RunEnvelope], frames: Mapping[str, pd.DataFrame],
@@ -73,7 +76,7 @@ def fast_floor(c: Candidate, theta: NDArray, runs: Sequence[RunEnvelope], frames
             continue
         at = with_transient(c, theta, [at])[0]
         d = predict(c, theta, at) / at.T
-        rows.append((rid, float(at.row.get("level_g", np.nan)), np.mean((20 * np.log10(np.abs(d)) / at.sigma_db) ** 2),
+        rows.append((rid, at.level, np.mean((20 * np.log10(np.abs(d)) / at.sigma_db) ** 2),
                      np.mean((np.degrees(np.angle(d)) / at.sigma_deg) ** 2)))
     if not rows:
         return {"E": None, "E_mag": None, "E_phase": None, "n_runs": 0, "per_level": {}, "per_run": {}}

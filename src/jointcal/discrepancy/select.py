@@ -37,6 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .data import RunEnvelope
+from ..io import level_column
 from ..effects import JOIN
 from .fit import Candidate, Fit, envelope_E, fit_candidate, with_transient
 from .rule import MARGIN, NONE_E, _above_floor, _ranked, _within_scatter_drift
@@ -58,19 +59,24 @@ class Scored:
 
 
 def _folds(runs: Sequence[RunEnvelope]) -> dict[str, list[int]]:
-    """Held-out folds: each level, and each sweep direction predicted from the other.
+    """Held-out folds: each level, each sweep direction predicted from the other, and each sweep rate from the
+    others (a sweep effect, or a model that only absorbs the fitted rate's transient).
 
     Levels test the amplitude dependence (a model that only absorbs the fitted levels predicts
     an unseen one no better); directions interleave in the run sequence (up, down, up, ...),
     so a drift with the sequence is judged on runs between fitted ones, and a sweep effect on
     the branch it was not fitted on."""
-    levels = [float(r.row["level_g"]) for r in runs]
-    folds = {f"{L:g} g": [i for i, v in enumerate(levels) if v == L] for L in sorted(set(levels))}
+    unit = (level_column(runs[0].row) or "_").split("_", 1)[1]  # the level's unit: g, lbf or V
+    levels = [r.level for r in runs]
+    folds = {f"{L:g} {unit}".strip(): [i for i, v in enumerate(levels) if v == L] for L in sorted(set(levels))}
     if len(folds) < 2:
         return {}
     dirs = [str(r.row.get("direction", "")) for r in runs]
     if len(set(dirs)) > 1:
         folds.update({d: [i for i, v in enumerate(dirs) if v == d] for d in sorted(set(dirs))})
+    rates = [float(r.row.get("sweep_rate_hz_per_s", np.nan)) for r in runs]  # each rate predicted from the others
+    if len(set(rates)) > 1 and all(np.isfinite(rates)):
+        folds.update({f"{rt:g} Hz/s": [i for i, v in enumerate(rates) if v == rt] for rt in sorted(set(rates))})
     return folds
 
 

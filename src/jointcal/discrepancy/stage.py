@@ -11,7 +11,7 @@
 4. Act: the named model recalibrated with the joint parameters (`recalibrate`:
    DEAP GA over the grown space seeded with the least-squares fits from the calibration's
    optimum and its other valleys, polish, emcee posterior for the 90% intervals),
-   revalidated by the TIME simulation driven by each run's measured base record
+   revalidated by the TIME simulation driven by each run's measured reference record
    (`jointcal.validate.validate_runs`, the validation stage's E: same definition, same
    runs) -> metric_before, metric_after. A 'none' that the time simulation contradicts
    (E above `rule.NONE_E` before and after) becomes 'unexplained'; a name the time
@@ -20,14 +20,18 @@
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 import pandas as pd
 
 from ..calibrate.space import PARAMS, ParamSpace
-from ..effects import effects_of
-from ..models import harmonic_balance
+from ..effects import EFFECTS, effects_of
+from ..calibrate.kind import backbone_at
+from ..io import level_column
+from ..io._contract import LEVEL
+from ..validate.drive import drive_gain
 from ..validate import ValidateSettings, model_from_best, validate_runs
 from .data import run_envelope, scale_arrays
 from .fingerprints import fingerprints, outside_library, residual_map, verdicts
@@ -109,6 +113,11 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     say = log or (lambda s: None)
     clock = _Clock()
     m = float(best["m"])
+    kind = str(best.get("model_kind", "ministack"))
+    settings = replace(settings, candidates=tuple(n for n in settings.candidates if kind in EFFECTS[n].kinds))
+    gain = drive_gain(modal[modal["assembly"] == assembly]) if level_column(modal.columns) != LEVEL["base"] else None
+    if gain is not None:  # a force or voltage drives the mode through the campaign's modal constant
+        rows = [{**r, "drive_gain": gain} for r in rows]
     theta0 = np.array([best[p] for p in PARAMS], dtype=float)
     vkw = dict(settings=validate_settings, envelopes_kw=envelopes_kw, modal_kw=modal_kw, executor=executor)
     if scale is None or frames_before is None:  # as the validation stage does: the calibrated model in time
@@ -144,7 +153,8 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     clock.lap("validate_after")
     effect, confidence, time_note = confirm(effect, confidence, float(metric_before), metric_after)
     diagnosis = {
-        "assembly": assembly, "effect": effect, "effects": list(effects_of(effect)) if effect not in (
+        "assembly": assembly, "model_kind": kind, "level_unit": (level_column(modal.columns) or "_").split("_", 1)[1],
+        "effect": effect, "effects": list(effects_of(effect)) if effect not in (
             "none", "unexplained") else [], "confidence": confidence, "rule": decision.rule,
         "rule_applied": [*decision.applied, *([CLAUSES[time_note]] if time_note else [])],
         "outside_library": outside,
@@ -228,11 +238,9 @@ def _localise(c0, base, runs, mrows, m, sdb):
     res = residual_map(c0, base.fit.theta, with_transient(c0, base.fit.theta, runs))
     usable = mrows.loc[[r.row["run_id"] for r in runs]].reset_index()
     jb = dict(zip(PARAMS, base.fit.theta))
-    model_fz = {}
-    for r in usable.itertuples():
-        f, z = harmonic_balance(r.q_in, jb["Fs"], jb["KT"], jb["chi"], jb["beta"], jb["k"], m, jb["zeta_v"])
-        model_fz[r.run_id] = (float(f), float(z))
-    sf = usable.groupby("level_g")["f_res_hz"].std().dropna() / usable["f_res_hz"].mean()
+    f, z = backbone_at(jb, m, usable["q_in"].to_numpy(float))
+    model_fz = {rid: (float(a), float(b)) for rid, a, b in zip(usable["run_id"], f, z)}
+    sf = usable.groupby(level_column(usable.columns))["f_res_hz"].std().dropna() / usable["f_res_hz"].mean()
     scatter_f = float(np.sqrt(np.mean(sf**2))) if len(sf) else 1e-4
     fp = fingerprints(res, usable, model_fz, jb, max(scatter_f, 2e-5), m)
     ver = verdicts(fp, float(sdb[-1]), max(scatter_f, 2e-5))

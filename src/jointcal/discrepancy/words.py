@@ -33,7 +33,8 @@ def _floor(d: Mapping) -> str:
     fl = d.get("fast_model_floor") or {}
     if fl.get("E") is None:
         return "The fast model's own error could not be measured (no time-simulated frames of the calibrated model)."
-    per = ", ".join(f"{k} g: {v:.2f}" for k, v in fl.get("per_level", {}).items())
+    unit = d.get("level_unit", "g")
+    per = ", ".join(f"{k} {unit}: {v:.2f}" for k, v in fl.get("per_level", {}).items())
     return (f"The fast model's own error on the calibrated model (its envelopes against the time simulation of the "
             f"same model, same runs and bins) is E = {fl['E']:.2f}" + (f" ({per})" if per else "") + ": "
             + ("well below the repeat scatter, so the held-out scores measure the model, not the fast model."
@@ -60,7 +61,7 @@ def _named(d: Mapping, E0: float, E1: float) -> list[str]:
     verb = "falls" if E1 < E0 else "does not fall"
     lines.append(f"With {'it' if len(effects) == 1 else 'them'} the validation error E (1 = the measured repeat "
                  f"scatter) {verb} from {E0:.2f} to {E1:.2f} ({(E1 / E0 - 1) * 100:+.0f}%), checked with the time "
-                 "simulation driven by each run's measured base record.")
+                 "simulation driven by each run's measured reference record.")
     if d.get("time_domain_check") == "name_not_confirmed":
         lines[-1] += (" The time simulation does not confirm the name, so its confidence is low: check the "
                       "advice above before acting on it.")
@@ -79,6 +80,11 @@ def _named(d: Mapping, E0: float, E1: float) -> list[str]:
         loose = lo <= bounds[k][0] * (1 + 1e-6) or hi >= bounds[k][1] * (1 - 1e-6)
         lines.append(f"- {k} = {v['value']:.4g} {v['unit']}, 90% interval [{lo:.4g}, {hi:.4g}]"
                      + (" (reaches a bound of the library's range: the data do not pin it)" if loose else ""))
+    joint = d["recalibrated"].get("joint_parameters", {})
+    if joint:
+        lines += ["", "The corrected joint (recalibrated with the effect; 90% intervals): " + "; ".join(
+            f"{k} {v['value']:.4g} [{v['interval_90'][0]:.4g}, {v['interval_90'][1]:.4g}]" for k, v in joint.items())
+            + "."]
     return lines
 
 

@@ -9,13 +9,19 @@ the discrepancy workflow fits, fingerprints, names and advises on it
 effect                 parameters                                       what it is
 =====================  ===============================================  ==========================================
 sensor_gain            gain (-)                                         response accelerometer sensitivity off
+                                                                        (Ministack only: one mode's modal constant
+                                                                        absorbs it)
 channel_delay          tau_s (s)                                        response channel lags the base channel
 fixture_flexibility    f_can_hz (Hz), m_can_ratio (-)                   can/fixture on its own spring below the
-                                                                        joint (zeta_can fixed at 1%)
+                                                                        joint (zeta_can fixed at 1%; Ministack)
 cubic_stiffening       k3 (lbf/in^3)                                    k3 z^3 spring beside the joint
-quadratic_damping      c2 (lbf s^2/in^2)                                c2 z'|z'| damper (air, foam)
+quadratic_damping      c2 (lbf s^2/in^2)                                c2 z'|z'| damper (air, foam; Ministack)
 joint_settling         Fs_drift (-), KT_drift (-), n_settle (runs)      Fs, KT rise with the run sequence n:
                                                                         X (1 + d (1 - exp(-(n-1)/n_settle)))
+elastic_softening      loss_ratio (-)                                   joint force r F_iwan + (1 - r) F_b: its
+                                                                        backbone, r of Masing's loss (modal only)
+neighbour_mode         f_ratio (-), mode_ratio (-)                      a linear mode the channel also reads
+                                                                        (modal only)
 contact_spring         contact_k (lbf/in), gap_in (in)                  a stop beyond a gap (even harmonics);
                                                                         outside the discrepancy library
 =====================  ===============================================  ==========================================
@@ -30,13 +36,13 @@ How to add an effect, in five lines:
 4. Add its name to the ``discrepancy.candidates`` enum of ``workflow/schemas/config.schema.yaml``.
 5. Add its row to the table above; synth, the models and the discrepancy workflow then know it.
 """
-from . import (channel_delay, contact_spring, cubic_stiffening, fixture_flexibility, joint_settling,
-               quadratic_damping, sensor_gain)
+from . import (channel_delay, contact_spring, cubic_stiffening, elastic_softening, fixture_flexibility, joint_settling,
+               neighbour_mode, quadratic_damping, sensor_gain)
 from .effect import Effect, EffectParam
 from .registry import EFFECTS, JOIN, apply_effect, effects_of, library, register
 
 for _module in (sensor_gain, channel_delay, fixture_flexibility, cubic_stiffening, quadratic_damping, joint_settling,
-                contact_spring):
+                elastic_softening, neighbour_mode, contact_spring):
     register(_module.EFFECT)
 
 __all__ = ["Effect", "EffectParam", "EFFECTS", "JOIN", "register", "library", "effects_of", "apply_effect"]

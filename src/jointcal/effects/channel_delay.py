@@ -1,4 +1,4 @@
-"""channel_delay: the response channel lags the base channel (filters, conditioners)."""
+"""channel_delay: the response channel lags the reference channel (base, force or drive voltage: filters, conditioners)."""
 from __future__ import annotations
 
 from dataclasses import replace
@@ -18,11 +18,11 @@ def _fingerprint(fp, sigma_db, sigma_f):
 
 
 def _advice(v):
-    return (f"the response channel lags the base channel by {v['tau_s'] * 1e6:.0f} us: check the anti-alias filters "
+    return (f"the response channel lags the reference channel by {v['tau_s'] * 1e6:.0f} us: check the anti-alias filters "
             "and signal conditioners of the two channels (same type and setting), or correct the phase by 2 pi f tau")
 
 
 EFFECT = Effect(
-    "channel_delay", (EffectParam("tau_s", "s", 0.0, 5e-4, False, 2e-5, "response channel delay relative to the base"),),
+    "channel_delay", (EffectParam("tau_s", "s", 0.0, 5e-4, False, 2e-5, "response channel delay relative to the reference"),),
     _apply, _advice, _fingerprint, hidden={"tau_s": 40e-6},
-    summary="response channel delayed by tau_s relative to the base channel (exact fractional delay)")
+    summary="response channel delayed by tau_s relative to the reference channel (exact fractional delay)")

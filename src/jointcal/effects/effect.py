@@ -17,7 +17,10 @@ An effect is physics a calibrated joint model may be missing. `Effect` holds:
 * ``advice(values) -> str``: what to check in the lab, in words;
 * ``hidden``: the strength at which the virtual lab (`jointcal.synth`) hides it by default;
 * ``library``: whether the discrepancy workflow tries it (an effect kept out on purpose tests
-  the workflow's 'unexplained').
+  the workflow's 'unexplained');
+* ``kinds``: the model kinds (`jointcal.calibrate.kind`) whose discrepancy library holds it:
+  ``ministack`` (the base-driven rig) and ``modal`` (one mode of any structure, force- or
+  voltage-driven). An effect that applies to both lives once.
 """
 from __future__ import annotations
 
@@ -63,6 +66,7 @@ class Effect:
     # its row); False: one model serves every run of a parameter set (the discrepancy fits build it once)
     library: bool = True
     summary: str = ""  # what it is, in a line
+    kinds: tuple[str, ...] = ("ministack", "modal")
 
     def __post_init__(self) -> None:
         names = [p.name for p in self.params]

@@ -38,4 +38,5 @@ EFFECT = Effect(
     (EffectParam("f_can_hz", "Hz", 1000.0, 30000.0, True, 6000.0, "own frequency of the can on its spring"),
      EffectParam("m_can_ratio", "-", 0.3, 50.0, True, 4.0, "moving can mass over slug mass")),
     _apply, _advice, _fingerprint, hidden={"f_can_hz": 5500.0, "m_can_ratio": 4.0},
-    summary="can/fixture on its own spring below the joint (zeta_can fixed at 1%): slug mode ~2-3% lower")
+    summary="can/fixture on its own spring below the joint (zeta_can fixed at 1%): slug mode ~2-3% lower",
+    kinds=("ministack",))  # the Ministack's can; one mode of another structure has its neighbour_mode

@@ -28,4 +28,5 @@ def _advice(v):
 EFFECT = Effect(
     "quadratic_damping",
     (EffectParam("c2", "lbf s^2/in^2", 0.0, 200.0, False, 0.5, "quadratic (velocity-squared) damper"),),
-    _apply, _advice, _fingerprint, hidden={"c2": 1.2}, summary="c2 z'|z'| damper beside the joint (air, foam)")
+    _apply, _advice, _fingerprint, hidden={"c2": 1.2}, summary="c2 z'|z'| damper beside the joint (air, foam)",
+    kinds=("ministack",))

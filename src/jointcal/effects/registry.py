@@ -26,9 +26,9 @@ def register(effect: Effect) -> Effect:
     return effect
 
 
-def library() -> tuple[str, ...]:
-    """The effects the discrepancy workflow tries, in registry order."""
-    return tuple(n for n, e in EFFECTS.items() if e.library)
+def library(kind: str | None = None) -> tuple[str, ...]:
+    """The effects the discrepancy workflow tries, in registry order (of one model kind, or of any)."""
+    return tuple(n for n, e in EFFECTS.items() if e.library and (kind is None or kind in e.kinds))
 
 
 def effects_of(name: str) -> tuple[str, ...]:

@@ -29,4 +29,7 @@ def _advice(v):
 EFFECT = Effect(
     "sensor_gain", (EffectParam("gain", "-", 0.5, 2.0, True, 1.0, "response channel reading / true acceleration"),),
     _apply, _advice, _fingerprint, hidden={"gain": 1.25},
-    summary="response accelerometer sensitivity off (the channel reads gain x the true acceleration)")
+    summary="response accelerometer sensitivity off (the channel reads gain x the true acceleration)",
+    # one mode driven by a force or a voltage reads its modal constant A from the same response channel:
+    # a gain g makes A g and q g, which the same joint with Fs g and KT, k per unit modal mass fits exactly
+    kinds=("ministack",))

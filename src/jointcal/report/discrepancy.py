@@ -93,6 +93,6 @@ def table_3_2_corrected_html(best: Mapping[str, Mapping], diagnoses: Mapping[str
             "font-family:sans-serif;font-size:13px}</style></head><body>"
             "<h3>Table 3.2: the paper's model and the corrected one</h3><table><tr><th>assembly</th><th>model</th>"
             + head + "<th>effect</th><th>validation E</th></tr>" + "".join(rows) + "</table>"
-            "<p>E: validation envelope error, time simulation driven by the measured base records "
+            "<p>E: validation envelope error, time simulation driven by the measured reference records "
             "(1 = the measured repeat scatter). 90%: the corrected model's posterior interval (emcee on the "
             "envelopes; approximate, see diagnosis.json's recalibrated.method).</p></body></html>")

@@ -116,9 +116,7 @@ def _item1(best: Mapping, validation: Mapping | None, fit: Mapping | None) -> st
 
 def _item2(diagnosis: Mapping | None, best: Mapping) -> str:
     if diagnosis is None:
-        exc = best.get("excitation", "base")
-        return (f"Not run: the discrepancy library holds the base-driven rig's effects; this campaign is {exc}-driven."
-                if exc != "base" else "The discrepancy stage did not run.")
+        return "The discrepancy stage did not run."
     E0, E1 = float(diagnosis["metric_before"]), float(diagnosis["metric_after"])
     effects = named_effects(diagnosis)
     if effects:
@@ -127,7 +125,7 @@ def _item2(diagnosis: Mapping | None, best: Mapping) -> str:
                          for k, v in rec.get("effect_parameters", {}).items())
         return (f"It names <b>{html.escape(' + '.join(effects))}</b> (confidence {html.escape(str(diagnosis.get('confidence')))})"
                 + (f": {pars}" if pars else "") + f". With it E goes from <b>{E0:.2f}</b> to <b>{E1:.2f}</b> "
-                f"({closeness(E1)}), checked with the time simulation driven by each run's measured base record.")
+                f"({closeness(E1)}), checked with the time simulation driven by each run's measured reference record.")
     if diagnosis.get("effect") == "none":
         return f"No missing effect: the paper's model predicts the levels it did not see within the scatter (E = {E0:.2f})."
     return (f"Unexplained: no library effect closes the gap decisively (E = {E0:.2f}); "

@@ -15,11 +15,12 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from ..io._contract import REFERENCE
+from ..io._contract import LEVEL, REFERENCE, level_column
 from ..models import MinistackModel, fractional_delay, simulate
 from ..units import G
 
-__all__ = ["reference_column", "clean_base", "drive_gain", "model_input", "simulate_record"]
+__all__ = ["reference_column", "clean_base", "drive_gain", "gain_at", "equivalent_base", "model_input",
+           "simulate_record"]
 
 
 def reference_column(record: pd.DataFrame) -> str:
@@ -64,12 +65,30 @@ def drive_gain(modal: pd.DataFrame) -> tuple[complex, complex, float] | None:
     return med(ac), med(da), wc
 
 
+def gain_at(gain: tuple[complex, complex, float], f_hz: NDArray) -> NDArray[np.complex128]:
+    """The modal constant A(w) = A_c + A' (w - w_c) at frequencies f (Hz), held beyond +-45% of w_c."""
+    ac, da, wc = gain
+    w = 2 * np.pi * np.asarray(f_hz, dtype=float)
+    return ac + da * np.clip(w - wc, -0.45 * wc, 0.45 * wc)
+
+
+def equivalent_base(row: Mapping, f_hz: NDArray) -> NDArray[np.complex128] | None:
+    """The equivalent base acceleration per unit reference at frequencies f, -A(w) / G (g per lbf or per V),
+    for a force or voltage run with its ``drive_gain``; None for a base drive (the reference is the base).
+
+    The model responds to a reference phasor R as to the base acceleration -A R / G: its
+    response channel reads Y = -(A / G) (T - s) R, T the base rig's transmissibility and s the
+    sensor's gain and delay (`simulate_record`)."""
+    gain = row.get("drive_gain")
+    if gain is None or level_column(row) == LEVEL["base"]:
+        return None
+    return -gain_at(gain, f_hz) / G
+
+
 def _through_gain(r: NDArray, fs: float, gain: tuple[complex, complex, float]) -> NDArray:
     """A(w) applied line by line to a real record (positive frequencies; the negative ones conjugate)."""
-    ac, da, wc = gain
     n = 1 << int(np.ceil(np.log2(2 * r.size)))
-    w = 2 * np.pi * np.fft.rfftfreq(n, 1.0 / fs)
-    a = ac + da * np.clip(w - wc, -0.45 * wc, 0.45 * wc)
+    a = gain_at(gain, np.fft.rfftfreq(n, 1.0 / fs))
     return np.fft.irfft(np.fft.rfft(r, n) * a, n)[:r.size]
 
 

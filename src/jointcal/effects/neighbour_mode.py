@@ -1,0 +1,50 @@
+"""neighbour_mode: another mode of the structure, outside the fitted one, that the response channel also reads.
+
+A force or voltage drives every mode of a structure, and an accelerometer reads them all: near
+the fitted mode the others add a residual, a mass line from the modes above, a stiffness
+line from those below, or a nearby peak. The model adds one linear mode,
+`jointcal.models.Neighbour`: relative acceleration over the (equivalent) base acceleration
+ratio w^2 / (w_n^2 - w^2 + 2 i zeta_n w_n w), w_n = f_ratio x the fitted mode's stuck-joint
+frequency, zeta_n fixed at 1%, ratio its modal constant over the fitted mode's. Both are fitted.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ..models import Neighbour
+from .effect import Effect, EffectParam
+
+__all__ = ["EFFECT", "ZETA_N"]
+
+ZETA_N = 0.01  # the neighbour's damping ratio, held: a residual outside the band does not fix it
+
+
+def _apply(model, v, row):
+    kt = 0.0 if model.iwan is None else model.iwan.KT
+    f0 = np.sqrt((np.asarray(model.k) + np.asarray(kt)) / np.asarray(model.m)) / (2 * np.pi)
+    return replace(model, neighbour=Neighbour(v["f_ratio"] * f0, v["mode_ratio"], ZETA_N))
+
+
+def _fingerprint(fp, sigma_db, sigma_f):
+    g, tr = fp.get("low_gain"), fp.get("low_gain_trend")
+    off = g is not None and abs(20 * np.log10(g)) > 3 * sigma_db
+    return off, (f"off resonance the measured response differs from the mode's by {20 * np.log10(g):+.2f} dB"
+                 + (f", changing by {tr:+.3f} per unit (f / f_res)^2" if tr is not None else "")
+                 if g is not None else "no frames off resonance")
+
+
+def _advice(v):
+    where = "above" if v["f_ratio"] > 1 else "below"
+    return (f"another mode {where} this one (about {v['f_ratio']:.2f} x its frequency, modal constant "
+            f"{v['mode_ratio']:+.2f} x) adds to the response: fit the two modes together, move the response "
+            "sensor towards a node of the other mode, or narrow the band of the test")
+
+
+EFFECT = Effect(
+    "neighbour_mode",
+    (EffectParam("f_ratio", "-", 0.2, 5.0, True, 2.0, "the neighbouring mode's frequency over the fitted mode's"),
+     EffectParam("mode_ratio", "-", -3.0, 3.0, False, 0.0, "its modal constant over the fitted mode's")),
+    _apply, _advice, _fingerprint, hidden={"f_ratio": 1.6, "mode_ratio": 0.5}, kinds=("modal",),
+    summary="a linear mode at f_ratio x f0 with mode_ratio x the modal constant, read by the same channel")
