@@ -20,8 +20,8 @@ from scipy.signal.windows import hann
 
 from ..io._clipping import clipped_mask
 from ..io._contract import REFERENCE, RESPONSE, excitation_kind
+from ..spectral import parabola_vertex
 from ..units import G
-from .peaks import parabola_vertex
 
 __all__ = ["EnvelopeMeta", "window_length", "track_drive", "envelopes", "meta_dict", "ENVELOPE_COLUMNS"]
 

@@ -24,10 +24,10 @@ import pandas as pd
 
 from ..io._contract import LEVEL, REFERENCE, RESPONSE
 from ..io._kinds import DWELL
+from ..spectral import peak_frequency
 from ..units import G
 from .dwell import dwell_mode, dwell_point
 from .modes import mode_name
-from .peaks import parabola_vertex
 from .ringdown import decay_start, ringdown_backbone
 
 __all__ = ["other_kinds_modal", "backbone_table", "BACKBONE_COLUMNS", "MIN_DECAY_S", "NEAR"]
@@ -39,7 +39,7 @@ IDENTITY = ("run_id", "assembly", "sequence", "direction")
 
 
 def _peak_hz(x: np.ndarray, fs: float, lo: float = 0.5, decay: bool = False) -> float:
-    """The largest spectral peak of `x` above `lo` Hz (8x zero padding, parabola on the log).
+    """The largest spectral peak of `x` above `lo` Hz (`jointcal.spectral.peak_frequency`, 8x zero padding).
 
     A decay is cut where it last stands 20x over its tail's median (the noise) and read without a
     window (it tapers itself); any other record under a Hann window.
@@ -48,14 +48,7 @@ def _peak_hz(x: np.ndarray, fs: float, lo: float = 0.5, decay: bool = False) -> 
         a = np.abs(x - np.median(x))
         noise = np.median(a[-max(a.size // 10, 1):])
         x = x[:max(int(np.flatnonzero(a > 20 * noise)[-1]) + 1 if (a > 20 * noise).any() else a.size, 64)]
-    y = (x - x.mean()) * (1.0 if decay else np.hanning(x.size))
-    n = 8 * x.size
-    mag = np.abs(np.fft.rfft(y, n))
-    mag[: int(np.ceil(lo * n / fs)) + 1] = 0.0
-    k = int(np.argmax(mag))
-    if 0 < k < mag.size - 1:
-        k = k + float(parabola_vertex(*np.log(mag[k - 1:k + 2] + 1e-300))[0])
-    return float(k * fs / n)
+    return peak_frequency(x, fs, pad=8, window=not decay, lo=lo)
 
 
 def _decay(resp: np.ndarray, ref: np.ndarray, fs: float) -> int | None:
