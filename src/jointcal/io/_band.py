@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from jointcal.io._contract import MIN_CYCLES, fail
+from jointcal.io.contract import MIN_CYCLES, fail
 from jointcal.spectral import peak_frequency
 
 __all__ = ["drive_band", "check_head", "dwell_band"]

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..io._contract import REFERENCE, RESPONSE
+from ..io.contract import REFERENCE, RESPONSE
 from ..units import G
 from .backbone import backbone_at_peak, pair_backbone
 from .peaks import envelope

@@ -35,7 +35,7 @@ from collections.abc import Callable
 import numpy as np
 import pandas as pd
 
-from ..io._contract import LEVEL, REFERENCE, RESPONSE, excitation_kind
+from ..io.contract import LEVEL, REFERENCE, RESPONSE, excitation_kind
 from ..io._kinds import kind_of
 from .envelopes import ENVELOPE_COLUMNS
 from .frf import displacement_ratio, h1_estimate

@@ -19,7 +19,7 @@ from scipy.signal import ShortTimeFFT, savgol_filter
 from scipy.signal.windows import hann
 
 from ..io._clipping import clipped_mask
-from ..io._contract import REFERENCE, RESPONSE, excitation_kind
+from ..io.contract import REFERENCE, RESPONSE, excitation_kind
 from ..spectral import parabola_vertex
 from ..units import G
 

@@ -33,7 +33,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..io._contract import LEVEL, REFERENCE, RESPONSE, excitation_kind
+from ..io.contract import LEVEL, REFERENCE, RESPONSE, excitation_kind
 from ..units import G
 from ._envelope_readout import EDGE, envelope_estimates
 from ._excited import REFIT, SWEEP_FRAME, ZETA_MAX, backbone_estimate, excited_readout, modal_constant, sweep_estimate

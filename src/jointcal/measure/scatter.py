@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..io._contract import level_column
+from ..io.contract import level_column
 
 __all__ = ["scatter"]
 

@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..io._contract import LEVEL, REFERENCE, RESPONSE
+from ..io.contract import LEVEL, REFERENCE, RESPONSE
 from ..io._kinds import DWELL
 from ..spectral import peak_frequency
 from ..units import G

@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from ..io._contract import REFERENCE
+from ..io.contract import REFERENCE
 from ..models import MinistackModel, simulate
 from ..units import G
 

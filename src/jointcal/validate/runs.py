@@ -32,7 +32,7 @@ import pandas as pd
 from numpy.typing import NDArray
 from scipy.signal.windows import hann
 
-from ..io._contract import LEVEL, REFERENCE, excitation_kind, level_column
+from ..io.contract import LEVEL, REFERENCE, excitation_kind, level_column
 from ..measure.modal import measure_run
 from ..measure.peaks import FULL_DRIVE, transmissibility
 from ..measure.peaks import full_drive as full_drive_frames

@@ -1,7 +1,8 @@
 """The raw-data contract's names and errors, and the one rule that tells a run's excitation.
 
-Private: `jointcal.io` re-exports `CampaignError`, `CampaignWarning`, `excitation_kind`
-and `level_column`.
+Public: the stages after ingest read a record's and a table's columns by these names
+(`REFERENCE`, `RESPONSE`, `LEVEL`, ...) and raise with `fail`. `jointcal.io` re-exports
+`CampaignError`, `CampaignWarning`, `excitation_kind` and `level_column`.
 """
 from __future__ import annotations
 
@@ -10,7 +11,9 @@ from typing import Literal, NoReturn
 
 from jointcal.units import FOOT_IN, G, G_SI, INCH_M, LBF_N
 
-__all__: list[str] = []
+__all__ = ["Excitation", "OnDataProblem", "TIME", "RESPONSE", "REFERENCE", "LEVEL", "RESPONSE_SI", "TEXT", "START",
+           "CHANNEL_COLUMNS", "POSITIVE", "QUANTITY", "UNITS", "SI_UNIT", "FS_RTOL", "MIN_CYCLES", "CampaignError",
+           "CampaignWarning", "fail", "excitation_kind", "level_column", "excitation_of"]
 
 Excitation = Literal["base", "force", "voltage"]
 OnDataProblem = Literal["error", "flag"]
