@@ -3,7 +3,7 @@
 Writes summary.csv, chain.npz, constraints.txt and predictive.csv; resumes from the chain
 checkpoint in params.checkpoint when it matches. Then identified.csv: which parameters and
 combinations the data identify, from the draws (jointcal.posterior.identified). Floors applied to the noise scales and
-a chain stopped by max_steps before 50 tau are reported on stderr and in the log.
+a chain stopped by max_steps before tau_factor tau are reported on stderr and in the log.
 (No ``from __future__``: Snakemake prepends a preamble to scripts.)
 """
 import json

@@ -39,6 +39,7 @@ from ._envelope_readout import EDGE, envelope_estimates
 from ._excited import REFIT, SWEEP_FRAME, ZETA_MAX, backbone_estimate, excited_readout, modal_constant, sweep_estimate
 from .envelopes import ENVELOPE_COLUMNS, envelopes
 from .frf import ModeFit, frf_flags, quadrature_ok, record_frf, zeta_at_quadrature
+from .sweepfit import WINDOW
 
 __all__ = ["modal_properties", "measure_run", "readout_rule", "FLAG_WORDS", "ENVELOPE_COLUMNS"]
 
@@ -54,7 +55,7 @@ FLAG_WORDS = {
     "frf_misfit": "the FRF's peak is not one linear mode (fit residual above frf_misfit: a nonlinear "
                   "structure's bent peak, a transient, overlapping modes or noise); zeta_frf and f_frf_hz are "
                   "doubtful, a quadrature read-out less so",
-    "sweep_truncated": "the record ends with the response still over the fitted window's level (15% of its peak): "
+    "sweep_truncated": f"the record ends with the response still over the fitted window's level ({WINDOW:.0%} of its peak): "
                        "the free decay that fixes the damping is cut (a real beam record cut 0.5 s after its "
                        "peak: zeta +1..+11%); record until the response has died out",
     "sweep_fit_failed": "the whole-transient fit of one mode did not fit (sweep_note says why); the FRF read-out "
