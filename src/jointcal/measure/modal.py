@@ -55,9 +55,9 @@ FLAG_WORDS = {
     "frf_misfit": "the FRF's peak is not one linear mode (fit residual above frf_misfit: a nonlinear "
                   "structure's bent peak, a transient, overlapping modes or noise); zeta_frf and f_frf_hz are "
                   "doubtful, a quadrature read-out less so",
-    "sweep_truncated": f"the record ends with the response still over the fitted window's level ({WINDOW:.0%} of its peak): "
-                       "the free decay that fixes the damping is cut (a real beam record cut 0.5 s after its "
-                       "peak: zeta +1..+11%); record until the response has died out",
+    "sweep_truncated": f"the record ends with the response still over the fitted window's level ({WINDOW:.0%} of "
+                       "its peak): the free decay that fixes the damping is cut (a real beam record cut 0.5 s after "
+                       "its peak: zeta +1..+11%); record until the response has died out",
     "sweep_fit_failed": "the whole-transient fit of one mode did not fit (sweep_note says why); the FRF read-out "
                         "is reported at the band-limited envelope peak, usable only for a quasi-steady sweep",
     "units": "the response/base ratio below resonance says the response is in other units than its column "
