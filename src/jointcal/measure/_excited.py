@@ -1,7 +1,7 @@
 """Force- and voltage-driven runs: the swept-mode fit of the whole transient, else the whole-record FRF.
 
 Private: `jointcal.measure.modal.modal_properties` calls `sweep_estimate`,
-`backbone_estimate` and `excited_readout` by the rule `jointcal.measure.modal.readout_rule`
+`backbone_estimate` and `excited_readout` by the rule `jointcal.measure.modal.READOUT_RULE`
 states.
 """
 from __future__ import annotations

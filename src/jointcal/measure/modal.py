@@ -1,7 +1,7 @@
 """Measured modal properties of one run: resonance, damping, amplitude and quality flags.
 
 From a run's envelopes (`jointcal.measure.envelopes`) and its record, by the rule
-`readout_rule` states (one row of modal_properties.csv):
+`READOUT_RULE` states (one row of modal_properties.csv):
 
 * base-driven runs: resonance where the relative displacement z is in quadrature with
   the base acceleration (z leads a_base by 90 deg), corrected for the sweep's lag: a
@@ -41,7 +41,7 @@ from .envelopes import ENVELOPE_COLUMNS, envelopes
 from .frf import ModeFit, frf_flags, quadrature_ok, record_frf, zeta_at_quadrature
 from .sweepfit import WINDOW
 
-__all__ = ["modal_properties", "measure_run", "readout_rule", "FLAG_WORDS", "ENVELOPE_COLUMNS"]
+__all__ = ["modal_properties", "measure_run", "READOUT_RULE", "FLAG_WORDS", "ENVELOPE_COLUMNS"]
 
 
 FLAG_WORDS = {
@@ -123,7 +123,7 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
     -------
     props : dict
         One row of modal_properties.csv: ``f_res_hz``, ``zeta_res`` and ``q_in`` read by
-        the rule of `readout_rule` (``f_res_method`` names it), every estimator's own
+        the rule of `READOUT_RULE` (``f_res_method`` names it), every estimator's own
         columns beside them, ``q_peak_in`` (the response's band-limited envelope peak near
         the mode, the check of q_in) and ``flags``.
     frf : DataFrame (only with ``with_frf``)
@@ -183,6 +183,7 @@ def _table_row(row: dict, kind: str, env_out: dict, read: dict, eta: float, eta_
     return out
 
 
+# the rule that picks each run's (f_res_hz, zeta_res, q_in), in words (raw_data/README.md quotes it)
 READOUT_RULE = (
     "Force- and voltage-driven runs: the swept-mode fit of the whole transient (sweep_fit) wherever it fits "
     f"(misfit <= modal.sweep_misfit, damping in (0, {ZETA_MAX:g}), resonance inside the band and within "
@@ -197,11 +198,6 @@ READOUT_RULE = (
     "quadrature_slope beyond eta_max) at the envelopes' amplitude there, or the FRF fit's quadrature beyond "
     "eta_frf (frf_fit), with the phase-resonance damping; the envelope peak (peak) where the phase never "
     "reaches quadrature.")
-
-
-def readout_rule() -> str:
-    """The rule that picks each run's (f_res_hz, zeta_res, q_in), in words (the contract quotes it)."""
-    return READOUT_RULE
 
 
 def _base_readout(env_out, fit, flags, eta, rate_hz_per_s, eta_frf, frf_misfit):
