@@ -33,7 +33,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..io.contract import LEVEL, REFERENCE, RESPONSE, excitation_kind
+from ..io.contract import LEVEL, REFERENCE, RESPONSE, UNUSABLE, excitation_kind
 from ..units import G
 from ._envelope_readout import EDGE, envelope_estimates
 from ._excited import REFIT, SWEEP_FRAME, ZETA_MAX, backbone_estimate, excited_readout, modal_constant, sweep_estimate
@@ -65,7 +65,7 @@ FLAG_WORDS = {
     "no_mode": "the run's band holds none of the modes found in its assembly's runs (jointcal.measure.modes)",
     "dead": "the response does not respond to the drive (an offset and noise: a dead or unplugged sensor; "
             "ingest's check); the run is left out",
-    "unusable": "no resonance could be estimated from this run",
+    UNUSABLE: "no resonance could be estimated from this run",
 }
 
 
@@ -178,7 +178,7 @@ def _table_row(row: dict, kind: str, env_out: dict, read: dict, eta: float, eta_
     if np.isfinite(eta) and eta > eta_max and method != "sweep_fit":  # the sweep fit needs no steady state
         flags.append("eta_high")
     if method == "none" or (method == "peak" and "resonance_outside_band" in flags):
-        flags.append("unusable")
+        flags.append(UNUSABLE)
     out.update(env_out, f_res_hz=float(f_res), f_res_method=method, eta=float(eta))
     return out
 

@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..io.contract import LEVEL, REFERENCE, RESPONSE
+from ..io.contract import LEVEL, REFERENCE, RESPONSE, UNUSABLE
 from ..io._kinds import DWELL
 from ..spectral import peak_frequency
 from ..units import G
@@ -171,7 +171,7 @@ def other_kinds_modal(rows: list[dict], records: dict, kind: str, swept: dict[st
             top = w.loc[w["q_in"].idxmax()]
             out.update(f_res_hz=top["f_hz"], zeta_res=top["zeta"], q_in=top["q_in"], f_res_method="ringdown")
         else:
-            flags += (r["dwell"]["fit"]["flags"] if r.get("dwell") else ["no_decay"]) + ["unusable"]
+            flags += (r["dwell"]["fit"]["flags"] if r.get("dwell") else ["no_decay"]) + [UNUSABLE]
         if w is not None and len(w):
             out["ringdown_windows"] = len(w)
             out["ringdown_decades"] = float(np.log10(w["q_in"].max() / w["q_in"].min()))
@@ -186,7 +186,7 @@ def backbone_table(modal: pd.DataFrame, points: list[dict]) -> pd.DataFrame:
 
     The rows flagged ``unusable`` are left out; the order is the modal table's runs, windows in time order.
     """
-    usable = ~modal["flags"].fillna("").str.contains("unusable")
+    usable = ~modal["flags"].fillna("").str.contains(UNUSABLE)
     method = modal["f_res_method"] if "f_res_method" in modal else pd.Series("", index=modal.index)
     sweep = ~method.isin(["dwell", "ringdown"])
     rows = modal.loc[usable & sweep]
