@@ -40,14 +40,13 @@ from ..io import write_bytes_atomic, write_csv_atomic
 from .likelihood import LogPosterior
 from .modes import find_modes, mode_labels, modes_text
 from .fit import P_REJECT, fit_test, goodness_of_fit
-from .identified import identified_table, unsettled
 from .noise import data_problem, noise_scale
 from .sampler import ChainResult, random_state_arrays, random_state_tuple, run_chain
 from .settings import PosteriorSettings
 from .summary import burn_in, constraints_text, predictive_band, summarize
 
 __all__ = ["OUTPUTS", "OBSERVED", "P_REJECT", "start_ball", "run_posterior", "posterior_of", "goodness_of_fit",
-           "fit_test", "run_identified"]
+           "fit_test"]
 
 OUTPUTS = ("summary.csv", "chain.npz", "constraints.txt", "predictive.csv")
 OBSERVED = ("Fs", "KT", "beta", "k")  # parameters whose own tau also counts in the stopping rule (y mixes them)
@@ -225,27 +224,6 @@ def run_posterior(modal_csv: str | os.PathLike[str], scatter_csv: str | os.PathL
     notes += [head, fit_line,
               f"noise floors (relative): frequency {data.rel_noise[0]:.3g}, damping {data.rel_noise[1]:.3g}"]
     return res, notes
-
-
-def run_identified(modal_csv: str | os.PathLike[str], ga_best_json: str | os.PathLike[str],
-                   chain_npz: str | os.PathLike[str], assembly: str, cal: CalibrateSettings, ps: PosteriorSettings,
-                   out_csv: str | os.PathLike[str]) -> str:
-    """Write ``identified.csv`` from the chain `run_posterior` wrote (`jointcal.posterior.identified`).
-
-    Which parameters and combinations the data identify, from the draws in `chain_npz`, with the
-    reason when the chain has not settled (`unsettled`). Returns a line for the log.
-    """
-    cal = cal.resolved(json.loads(Path(ga_best_json).read_text()))
-    data = read_modal(modal_csv, assembly, damping=cal.damping)
-    with np.load(chain_npz) as z:
-        names = [str(n) for n in z["sample_names"]]
-        why_not = unsettled({k: z[k] for k in z.files}, names, tau_factor=ps.tau_factor)
-        table, _ = identified_table(z["samples"], names, cal.space, data.q, data.f, data.zeta, m=cal.m,
-                                    model=cal.model, viscous=cal.viscous, ratio=ps.constrained_ratio,
-                                    why_not=why_not)
-    write_csv_atomic(table, out_csv)
-    return ("identified: " + ", ".join(table.loc[table["identified"], "quantity"]) + "; left to the bounds: "
-            + ", ".join(table.loc[~table["identified"], "quantity"]) + (f" ({why_not})" if why_not else ""))
 
 
 def _write(out: Path, lp: LogPosterior, res: ChainResult, theta: np.ndarray, best: dict, cal: CalibrateSettings,
