@@ -13,7 +13,6 @@ import pytest
 import scipy.io
 from _campaign import DATA, edit_manifest, edit_run
 
-from jointcal.io._band import peak_frequency
 from jointcal.io._clipping import clip_levels
 from jointcal.io import (
     CampaignError, CampaignWarning, ingest_campaign, read_manifest, read_run, validate_run,
@@ -98,12 +97,6 @@ def test_free_decay_tail_is_accepted(small_campaign):
     checks = validate_run(pd.concat([df, tail], ignore_index=True), row, "long.csv")
     assert checks["n_samples"] == len(df) + n_tail
     assert abs(checks["f_last_hz"] - 1500.0) < 5.0
-
-
-def test_peak_frequency_of_a_tone():
-    fs, f = 12800.0, 2345.6
-    x = np.sin(2 * np.pi * f * np.arange(400) / fs)
-    assert abs(peak_frequency(x, fs) - f) < 1.0
 
 
 def test_clip_levels_finds_both_limits():

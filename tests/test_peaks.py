@@ -5,21 +5,8 @@ import pytest
 
 from jointcal.io import excitation_kind, level_column
 from jointcal.measure.peaks import (
-    anchored_phase, full_drive, half_power, half_power_lines, parabola_vertex, phase_crossing, transmissibility,
+    anchored_phase, full_drive, half_power, half_power_lines, phase_crossing, transmissibility,
 )
-
-
-@pytest.mark.parametrize("x0, a, c", [(0.3, -2.0, 5.0), (-0.45, -0.1, 1.0), (0.0, -7.0, -3.0)])
-def test_parabola_vertex_is_exact_for_a_parabola(x0, a, c):
-    y = a * (np.array([-1.0, 0.0, 1.0]) - x0) ** 2 + c
-    delta, top = parabola_vertex(*y)
-    assert float(delta) == pytest.approx(x0, abs=1e-12)
-    assert float(top) == pytest.approx(c, rel=1e-12)
-
-
-def test_parabola_vertex_gives_no_offset_without_a_peak():
-    delta, top = parabola_vertex(np.array([1.0, 0.0]), np.array([2.0, 0.0]), np.array([3.0, 1.0]))
-    assert np.array_equal(delta, [0.0, 0.0]) and np.array_equal(top, [2.0, 0.0])
 
 
 @pytest.mark.parametrize("zeta", [0.005, 0.02, 0.05])

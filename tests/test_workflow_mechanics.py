@@ -20,6 +20,7 @@ import pytest
 from _campaign import REPO, SMALL_CAMPAIGN, edit_manifest
 from _modal_tables import TABLE_3_2, modal_tables, write_tables
 
+from jointcal import _workflow
 from jointcal._workflow import campaign_index, config_problem, pending_outputs, stage_sources
 from jointcal.calibrate import CalibrateSettings, run_calibration
 from jointcal.posterior import PosteriorSettings, run_posterior
@@ -48,6 +49,23 @@ def test_stage_sources_follow_imports_through_the_package():
     # `from ..calibrate.space import ...` in report/calibration.py, and the packages' __init__ files
     figures = _names(stage_sources(SCRIPTS / "calibration_figures.py"))
     assert {"report/__init__.py", "report/calibration.py", "calibrate/__init__.py", "calibrate/space.py"} <= figures
+
+
+def test_an_edit_of_measure_peaks_changes_no_stage_hash_before_modal(tmp_path, monkeypatch):
+    """The hash the rules pass as params (common.smk's source_hash: `stage_hash` of the script), on a copy of the
+    package whose measure/peaks.py is edited: ingest, envelopes and the kernels keep theirs, modal's changes."""
+    before_modal = [re.search(r'script:\s*"\.\./scripts/(\w+\.py)"', block).group(1)
+                    for smk in ("ingest", "envelopes", "kernels")
+                    for block in re.split(r"(?m)^(?=rule )", (REPO / "workflow" / "rules" / f"{smk}.smk").read_text())
+                    if "script:" in block]
+    assert {"ingest.py", "envelopes.py", "kernels.py"} <= set(before_modal)
+    pkg = tmp_path / "jointcal"
+    shutil.copytree(REPO / "src" / "jointcal", pkg, ignore=shutil.ignore_patterns("__pycache__"))
+    monkeypatch.setattr(_workflow, "_ROOT", pkg.resolve())
+    hashes = {s: _workflow.stage_hash(SCRIPTS / s) for s in [*before_modal, "modal.py"]}
+    _edit(pkg / "measure" / "peaks.py")
+    assert {s: _workflow.stage_hash(SCRIPTS / s) for s in before_modal} == {s: hashes[s] for s in before_modal}
+    assert _workflow.stage_hash(SCRIPTS / "modal.py") != hashes["modal.py"]  # the hash does see the edit
 
 
 def test_every_script_rule_carries_its_code_hash_a_benchmark_and_slurm_threads():

@@ -5,18 +5,16 @@
 import json
 from pathlib import Path
 
+from jointcal._stage_job import stage_job
 from jointcal._workflow import unit_labels
 from jointcal.io import write_bytes_atomic
 from jointcal.report.discrepancy import table_3_2_corrected_html
 
-
-def main(smk) -> None:
+with stage_job(snakemake) as job:  # noqa: F821 (provided by Snakemake)
+    smk = job.smk
     names = unit_labels(smk.input.best)  # assembly (and mode: jointcal._workflow)
     best = {a: json.loads(Path(p).read_text()) for a, p in zip(names, smk.input.best)}
     diag = {a: json.loads(Path(p).read_text()) for a, p in zip(names, smk.input.diagnosis)}
     write_bytes_atomic(table_3_2_corrected_html(best, diag).encode(), smk.output.table)
-    Path(smk.log[0]).write_text("".join(f"jointcal: {a}: {d['effect']} ({d['confidence']}), E "
-                                        f"{d['metric_before']:.2f} -> {d['metric_after']:.2f}\n" for a, d in diag.items()))
-
-
-main(snakemake)  # noqa: F821 (provided by Snakemake)
+    for a, d in diag.items():
+        job.log(f"{a}: {d['effect']} ({d['confidence']}), E {d['metric_before']:.2f} -> {d['metric_after']:.2f}")

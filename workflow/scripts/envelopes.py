@@ -2,54 +2,39 @@
 
 The runs are spread over a process pool of snakemake.threads workers. A run that cannot be
 processed (too short, no drive found) gets an empty envelope table and its one-sentence
-reason in the metadata, so the other runs go on and the modal stage flags it.
+reason in the metadata and the log, so the other runs go on and the modal stage flags it.
 (No ``from __future__``: Snakemake prepends a preamble.)
 """
-import sys
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import pandas as pd
 
+from jointcal._stage_job import stage_job
 from jointcal.io import listed_record, read_run, test_kind, write_csv_atomic, write_json_atomic
 from jointcal.measure.envelopes import ENVELOPE_COLUMNS, envelopes, meta_dict
 
 
-def one_run(path: str, row: dict, settings: dict, env_file: str, meta_file: str) -> str:
-    """Write one run's envelopes and metadata; return its log line."""
-    if test_kind(row) != "sweep":  # a dwell or ring-down: read by the modal stage from its record
-        write_csv_atomic(pd.DataFrame(columns=list(ENVELOPE_COLUMNS)), env_file)
-        write_json_atomic({"error": "", "test": test_kind(row)}, meta_file)
-        return f"jointcal: {row['run_id']}: a {test_kind(row)} run, no sweep envelopes"
-    try:
-        env, meta = envelopes(read_run(path, row), row, **settings)
-        meta = {**meta_dict(meta), "error": ""}
-        note = f"jointcal: {row['run_id']}: {meta['n_frames']} frames, window {meta['window_s'] * 1e3:.1f} ms"
-    except ValueError as exc:
-        env, meta = pd.DataFrame(columns=list(ENVELOPE_COLUMNS)), {"error": str(exc)}
-        note = f"jointcal: warning: {exc}"
+def one_run(path: str, row: dict, settings: dict, env_file: str, meta_file: str) -> tuple[str, bool]:
+    """Write one run's envelopes and metadata; return its log line and whether it is a warning."""
+    env, meta = pd.DataFrame(columns=list(ENVELOPE_COLUMNS)), {"error": "", "test": test_kind(row)}
+    note = (f"{row['run_id']}: a {meta['test']} run, no sweep envelopes", False)  # read by modal from its record
+    if meta["test"] == "sweep":
+        try:
+            env, m = envelopes(read_run(path, row), row, **settings)
+            meta = {**meta_dict(m), "error": ""}
+            note = (f"{row['run_id']}: {meta['n_frames']} frames, window {meta['window_s'] * 1e3:.1f} ms", False)
+        except ValueError as exc:
+            meta, note = {"error": str(exc)}, (str(exc), True)
     write_csv_atomic(env, env_file)
     write_json_atomic(meta, meta_file)
     return note
 
 
-def main(smk) -> None:
-    rows = pd.read_csv(smk.input.runs, dtype={"flags": str}).set_index("run_id", drop=False)
-    jobs = []
-    for env_file, meta_file in zip(smk.output.env, smk.output.meta):
-        row = rows.loc[Path(env_file).stem].to_dict()
-        path = listed_record(str(row["file"]), list(smk.input.records))  # whole path: basenames may repeat
-        jobs.append((path, row, dict(smk.params.envelopes), env_file, meta_file))
-    n = max(1, min(int(smk.threads), len(jobs)))
-    if n > 1:
-        with ProcessPoolExecutor(max_workers=n) as ex:
-            notes = list(ex.map(one_run, *zip(*jobs)))
-    else:
-        notes = [one_run(*job) for job in jobs]
-    for note in notes:
-        if "warning" in note:
-            print(note, file=sys.stderr)
-    Path(smk.log[0]).write_text("\n".join(notes) + "\n")
-
-
-main(snakemake)  # noqa: F821
+with stage_job(snakemake) as job:  # noqa: F821 (provided by Snakemake)
+    smk = job.smk
+    table = pd.read_csv(smk.input.runs, dtype={"flags": str}).set_index("run_id", drop=False)
+    rows = [table.loc[Path(f).stem].to_dict() for f in smk.output.env]
+    paths = [listed_record(str(r["file"]), list(smk.input.records)) for r in rows]  # whole path: basenames may repeat
+    for line, warn in job.map(one_run, paths, rows, [dict(smk.params.envelopes)] * len(rows), smk.output.env,
+                              smk.output.meta):
+        (job.warn if warn else job.log)(line)

@@ -7,12 +7,13 @@ from pathlib import Path
 
 import pandas as pd
 
+from jointcal._stage_job import stage_job
 from jointcal.io import level_column, listed_record, read_run, test_kind
 from jointcal.measure.envelopes import window_length
 from jointcal.report.modal import plot_envelopes, plot_frequency_damping, plot_spectrogram
 
-
-def main(smk) -> None:
+with stage_job(snakemake) as job:  # noqa: F821 (provided by Snakemake)
+    smk = job.smk
     table = pd.read_csv(smk.input.table, dtype={"flags": str})
     runs = pd.read_csv(smk.input.runs, dtype={"flags": str}).set_index("run_id", drop=False)
     envs = {Path(p).stem: pd.read_csv(p) for p in smk.input.env}
@@ -30,7 +31,4 @@ def main(smk) -> None:
         n = int(round(2.0 * row["sample_rate_hz"]))
     record = read_run(listed_record(row["file"], list(smk.input.records)), row)  # whole path: basenames may repeat
     plot_spectrogram(record, envs[rid], row["sample_rate_hz"], n, rid, smk.output.spectrogram)
-    Path(smk.log[0]).write_text(f"jointcal: figures written; spectrogram of {rid}\n")
-
-
-main(snakemake)  # noqa: F821
+    job.log(f"figures written; spectrogram of {rid}")

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from jointcal._stage_job import stage_job
 from jointcal.calibrate import PARAMS, CalibrateSettings
 from jointcal.io import write_bytes_atomic
 from jointcal.posterior import PosteriorSettings
@@ -18,26 +19,21 @@ from jointcal.report._corner_axes import corner_coordinates
 from jointcal.report.corner import corner_figure
 from jointcal.report.summary import chain_status, ga_best_point, rst_escape
 
-
-def main(smk) -> None:
+with stage_job(snakemake) as job:  # noqa: F821 (provided by Snakemake)
+    smk = job.smk
     best = json.loads(Path(smk.input.best).read_text())
     cal = CalibrateSettings.from_config(smk.params.calibrate).resolved(best)
-    post = PosteriorSettings.from_config(smk.params.posterior)
     with np.load(smk.input.chain) as z:
         arrays = {k: z[k] for k in z.files}
     samples, names = arrays["samples"], [str(n) for n in arrays["sample_names"]]
     points = {"GA best": ga_best_point(pd.read_csv(smk.input.history)),
               "polished optimum": {p: best[p] for p in PARAMS}}
     x, labels, points, bounds = corner_coordinates(samples, names, points, cal.full_bounds)
-    ok, line = chain_status(arrays, tau_factor=post.tau_factor)
-    modes = arrays.get("sample_mode")
+    ok, line = chain_status(arrays, tau_factor=PosteriorSettings.from_config(smk.params.posterior).tau_factor)
     write_bytes_atomic(corner_figure(x, labels, title=f"posterior of {smk.wildcards.assembly}", points=points,
-                                     bounds=bounds, modes=modes, stamp=(line.split(";")[0], ok)),
+                                     bounds=bounds, modes=arrays.get("sample_mode"), stamp=(line.split(";")[0], ok)),
                        smk.output.corner)
     text = [f"**This run: {rst_escape(line)}.**"]
     text += [rst_escape(s) for s in Path(smk.input.constraints).read_text().splitlines()[1:] if s.strip()]
     write_bytes_atomic(("\n\n".join(text) + "\n").encode(), smk.output.caption)
-    Path(smk.log[0]).write_text(f"jointcal: corner plot of {len(samples)} posterior draws; {line}\n")
-
-
-main(snakemake)  # noqa: F821 (provided by Snakemake)
+    job.log(f"corner plot of {len(samples)} posterior draws; {line}")

@@ -28,7 +28,7 @@ from typing import Literal
 import numpy as np
 import pandas as pd
 
-from ..io._contract import LEVEL, excitation_kind
+from ..io.contract import LEVEL, excitation_kind
 from ..models import harmonic_balance
 
 __all__ = ["KINDS", "Kind", "excitation_of_table", "kind_of", "data_bounds", "model_words", "backbone_at"]

@@ -30,7 +30,7 @@ from ..calibrate.space import PARAMS, ParamSpace
 from ..effects import EFFECTS, effects_of
 from ..calibrate.kind import backbone_at
 from ..io import level_column
-from ..io._contract import LEVEL
+from ..io.contract import LEVEL
 from ..validate.drive import drive_gain
 from ..validate import ValidateSettings, model_from_best, validate_runs
 from .data import run_envelope, scale_arrays

@@ -12,7 +12,7 @@ File I/O of the package lives here.
 
 Modules, in the order a record flows through them:
 
-* `_contract`: the contract's names, units and errors; `excitation_kind`, the one rule
+* `contract` (public): the contract's names, units and errors; `excitation_kind`, the one rule
   that tells a run's excitation from its columns or its level column.
 * `_manifest`: ``manifest.csv``, every row checked (`read_manifest`).
 * `_records`: one record, the contract's CSV or MAT (`read_run`), a whole campaign
@@ -30,7 +30,7 @@ Modules, in the order a record flows through them:
 """
 from __future__ import annotations
 
-from jointcal.io._contract import CampaignError, CampaignWarning, excitation_kind, level_column
+from jointcal.io.contract import CampaignError, CampaignWarning, excitation_kind, level_column
 from jointcal.io._atomic import write_bytes_atomic, write_csv_atomic, write_json_atomic, write_run
 from jointcal.io._checks import UNUSABLE_FLAGS, validate_run
 from jointcal.io._kinds import kind_of as test_kind

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from jointcal.io._contract import LEVEL, QUANTITY, REFERENCE, RESPONSE, UNITS
+from jointcal.io.contract import LEVEL, QUANTITY, REFERENCE, RESPONSE, UNITS
 from jointcal.io._transmissibility import LowRatio, low_frequency_ratio, response_ratio
 from jointcal.io._windows import sums, windows
 

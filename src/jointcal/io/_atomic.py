@@ -19,7 +19,7 @@ import pandas as pd
 import scipy.io
 from numpy.typing import ArrayLike
 
-from jointcal.io._contract import REFERENCE, RESPONSE, TIME, Excitation
+from jointcal.io.contract import REFERENCE, RESPONSE, TIME, Excitation
 
 __all__ = ["write_bytes_atomic", "write_csv_atomic", "write_json_atomic", "write_run"]
 

@@ -7,42 +7,12 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from jointcal.io._contract import MIN_CYCLES, fail
-from jointcal.measure.peaks import parabola_vertex
+from jointcal.io.contract import MIN_CYCLES, fail
+from jointcal.spectral import peak_frequency
 
-__all__ = ["peak_frequency", "drive_band", "check_head", "dwell_band"]
+__all__ = ["drive_band", "check_head", "dwell_band"]
 
 HEAD_LEVEL = 0.1  # a head quieter than this fraction of the reference's amplitude is silent
-
-
-def peak_frequency(x: NDArray[np.float64], fs: float, *, pad: int = 16) -> float:
-    """Frequency of the largest spectral peak of a short record (Hz).
-
-    Parameters
-    ----------
-    x : ndarray of float, shape (n,)
-        Short record (any unit); non-finite samples are treated as 0.
-    fs : float
-        Sample rate (Hz).
-    pad : int, optional
-        Zero-padding factor of the FFT (the peak is then refined by a parabola
-        through the three highest bins of the log magnitude).
-
-    Returns
-    -------
-    float
-        Peak frequency (Hz) of the Hann-windowed, mean-removed record. For a
-        linear chirp this is the instantaneous frequency at the record's centre.
-    """
-    y = np.nan_to_num(np.asarray(x, dtype=np.float64), nan=0.0, posinf=0.0, neginf=0.0)
-    y = (y - y.mean()) * np.hanning(y.size)
-    nfft = pad * y.size
-    mag = np.abs(np.fft.rfft(y, nfft))
-    mag[: pad + 1] = 0.0  # ignore DC and the first bin: the record is mean-removed
-    k = int(np.argmax(mag))
-    if 0 < k < mag.size - 1 and mag[k] > 0:
-        k = k + float(parabola_vertex(*np.log(mag[k - 1 : k + 2] + 1e-300))[0])  # on the log magnitude
-    return float(k * fs / nfft)
 
 
 def check_head(drive: NDArray[np.float64], amp: NDArray[np.float64], fs: float, f0: float, f1: float, rate: float,

@@ -18,7 +18,7 @@ from jointcal.io._amplitudes import level_problems, swap_problem, window_amplitu
 from jointcal.io._band import check_head, drive_band, dwell_band
 from jointcal.io._clipping import clip_levels, clipped_mask
 from jointcal.io._dead import dead_problem
-from jointcal.io._contract import (
+from jointcal.io.contract import (
     LEVEL, REFERENCE, RESPONSE, TIME, CampaignError, CampaignWarning, OnDataProblem,
     excitation_kind, excitation_of, fail,
 )

@@ -11,7 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from jointcal.io._windows import quadrature, sums, windows
-from jointcal.io._contract import RESPONSE
+from jointcal.io.contract import RESPONSE
 
 __all__ = ["drive_share", "dead_problem", "DEAD_SHARE", "NOISE_TIMES"]
 

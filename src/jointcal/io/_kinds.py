@@ -15,7 +15,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from jointcal.io._contract import fail
+from jointcal.io.contract import fail
 
 __all__: list[str] = []
 

@@ -18,7 +18,7 @@ import numpy as np
 import scipy.io
 from numpy.typing import NDArray
 
-from jointcal.io._contract import fail
+from jointcal.io.contract import fail
 from jointcal.io._lab_units import label, testlab_unit, uff_unit, unit_size
 
 __all__ = ["Channel", "lab_channels"]

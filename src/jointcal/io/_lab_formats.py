@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from jointcal.io._contract import CHANNEL_COLUMNS, QUANTITY, REFERENCE, RESPONSE, TIME, UNITS, Excitation, fail
+from jointcal.io.contract import CHANNEL_COLUMNS, QUANTITY, REFERENCE, RESPONSE, TIME, UNITS, Excitation, fail
 from jointcal.io._lab_channels import Channel, lab_channels
 from jointcal.io._lab_units import unit_size
 

@@ -23,7 +23,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from jointcal.io._contract import SI_UNIT, UNITS, fail
+from jointcal.io.contract import SI_UNIT, UNITS, fail
 
 __all__ = ["testlab_unit", "uff_unit", "unit_size", "label"]
 

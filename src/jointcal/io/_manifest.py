@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from jointcal.io._contract import LEVEL, POSITIVE, START, TEXT, CampaignWarning, fail
+from jointcal.io.contract import LEVEL, POSITIVE, START, TEXT, CampaignWarning, fail
 from jointcal.io._kinds import DWELL, REF_FILE, SWEEP_ONLY, TEST, manifest_kind
 
 __all__ = ["read_manifest", "check_csv_text"]

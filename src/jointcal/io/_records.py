@@ -15,7 +15,7 @@ import scipy.io
 from numpy.typing import NDArray
 
 from jointcal.io._checks import validate_run
-from jointcal.io._contract import (
+from jointcal.io.contract import (
     CHANNEL_COLUMNS, LEVEL, REFERENCE, RESPONSE, RESPONSE_SI, START, TIME, Excitation, OnDataProblem,
     excitation_kind, excitation_of, fail,
 )

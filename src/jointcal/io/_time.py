@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from jointcal.io._contract import FS_RTOL, fail
+from jointcal.io.contract import FS_RTOL, fail
 
 __all__ = ["check_time", "time_resolution", "JITTER"]
 

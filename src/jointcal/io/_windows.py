@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from jointcal.io._contract import MIN_CYCLES
+from jointcal.io.contract import MIN_CYCLES
 
 __all__ = ["windows", "sums", "quadrature"]
 

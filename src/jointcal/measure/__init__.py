@@ -10,9 +10,10 @@ Modules, in the order a record flows through them (import from the module: this
 * `sweepfit` (with `_rotating` and `_sweep_problem`): one amplitude-dependent mode fitted
   to a swept run's whole transient.
 * `modal` (with `_envelope_readout` and `_excited`): resonance, damping and amplitude of
-  one run, by one read-out rule (`modal.readout_rule`); `modal.measure_run` chains
+  one run, by one read-out rule (`modal.READOUT_RULE`); `modal.measure_run` chains
   envelopes -> modal.
 * `scatter`: the read-outs' spread across repeats and up/down pairs.
-* `peaks`: the small read-outs they and other stages share (peak parabola, half-power,
-  quadrature crossing, full-drive frames, transmissibility).
+* `peaks`: the small read-outs they and other stages share (half-power, quadrature
+  crossing, full-drive frames, transmissibility); the peak parabola and a record's peak
+  frequency, which `jointcal.io` uses too, are in `jointcal.spectral`.
 """

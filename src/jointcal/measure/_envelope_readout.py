@@ -11,9 +11,10 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from ..io._contract import REFERENCE
+from ..io.contract import REFERENCE
+from ..spectral import parabola_vertex
 from ..units import G
-from .peaks import anchored_phase, envelope, full_drive, half_power, parabola_vertex, phase_crossing, transmissibility
+from .peaks import anchored_phase, envelope, full_drive, half_power, phase_crossing, transmissibility
 
 __all__ = ["envelope_estimates"]
 

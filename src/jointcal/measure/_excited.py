@@ -1,7 +1,7 @@
 """Force- and voltage-driven runs: the swept-mode fit of the whole transient, else the whole-record FRF.
 
 Private: `jointcal.measure.modal.modal_properties` calls `sweep_estimate`,
-`backbone_estimate` and `excited_readout` by the rule `jointcal.measure.modal.readout_rule`
+`backbone_estimate` and `excited_readout` by the rule `jointcal.measure.modal.READOUT_RULE`
 states.
 """
 from __future__ import annotations
@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..io._contract import REFERENCE, RESPONSE
+from ..io.contract import REFERENCE, RESPONSE, UNUSABLE
 from ..units import G
 from .backbone import backbone_at_peak, pair_backbone
 from .peaks import envelope
@@ -63,7 +63,7 @@ def excited_readout(env_out, fit, sweep, why, flags, kind, f_bb, z_bb, rate_hz_p
     frf_flags(fit, flags, frf_misfit)
     eta = rate_hz_per_s / (f_res * zeta) ** 2 if zeta > 0 else np.inf
     if not eta <= eta_max:  # an FRF read-out of a chirp faster than the mode belongs to no known amplitude
-        flags.append("unusable")
+        flags.append(UNUSABLE)
     q_peak = band_envelope_peak(record, row, kind, f_res)
     return dict(f_res_hz=f_res, f_res_method=method, q_in=q_peak, zeta_res=zeta, q_peak_in=q_peak, eta=eta)
 

@@ -35,7 +35,7 @@ from collections.abc import Callable
 import numpy as np
 import pandas as pd
 
-from ..io._contract import LEVEL, REFERENCE, RESPONSE, excitation_kind
+from ..io.contract import LEVEL, REFERENCE, RESPONSE, UNUSABLE, excitation_kind
 from ..io._kinds import kind_of
 from .envelopes import ENVELOPE_COLUMNS
 from .frf import displacement_ratio, h1_estimate
@@ -121,7 +121,7 @@ def campaign_modal(runs: pd.DataFrame, load: Callable[[dict], tuple], modal_kw: 
             continue
         env, meta, record = load(row)
         if meta.get("error") and record is None:
-            rows.append({**{k: row.get(k) for k in IDENTITY}, "mode": "", "flags": "unusable"})
+            rows.append({**{k: row.get(k) for k in IDENTITY}, "mode": "", "flags": UNUSABLE})
             notes.append(f"{row['run_id']}: {meta['error']}")
             continue
         if meta.get("error"):  # no envelopes: the whole-record FRF alone
@@ -167,7 +167,7 @@ def _other_kinds(others: list[dict], rows: list[dict], load: Callable, mode_hz, 
         records = {r["run_id"]: load(r)[2] for r in grows}
         first = next((v for v in records.values() if v is not None), None)
         kind = excitation_kind([*(first.columns if first is not None else []), *grows[0]])
-        mine = [r for r in rows if r.get("assembly") == assembly and "unusable" not in str(r.get("flags", ""))]
+        mine = [r for r in rows if r.get("assembly") == assembly and UNUSABLE not in str(r.get("flags", ""))]
         swept = {}
         for r in sorted(mine, key=lambda r: r.get(LEVEL[kind], np.inf)):
             if r.get("mode") and np.isfinite(r.get("f_res_hz", np.nan)):
@@ -241,7 +241,7 @@ def _name_modes(read: list, kind: str) -> None:
     level = LEVEL[kind]
     for key in dict.fromkeys(g for _, _, g, n in read if n is None):
         outs = [o for o, _, g, n in read if n is None and g == key]
-        usable = [o for o in outs if "unusable" not in o["flags"] and np.isfinite(o.get("f_res_hz", np.nan))]
+        usable = [o for o in outs if UNUSABLE not in o["flags"] and np.isfinite(o.get("f_res_hz", np.nan))]
         low = min(usable or outs, key=lambda o: (o.get(level, np.inf), str(o["run_id"])))
         f = low.get("f_res_hz", np.nan)
         name = mode_name(f) if np.isfinite(f) else (mode_name(key) if key is not None else "m0")

@@ -19,11 +19,14 @@ from scipy.signal import ShortTimeFFT, savgol_filter
 from scipy.signal.windows import hann
 
 from ..io._clipping import clipped_mask
-from ..io._contract import REFERENCE, RESPONSE, excitation_kind
+from ..io.contract import REFERENCE, RESPONSE, excitation_kind
+from ..spectral import parabola_vertex
 from ..units import G
-from .peaks import parabola_vertex
 
-__all__ = ["EnvelopeMeta", "window_length", "track_drive", "envelopes", "meta_dict", "ENVELOPE_COLUMNS"]
+__all__ = ["EnvelopeMeta", "window_length", "track_drive", "envelopes", "meta_dict", "ENVELOPE_COLUMNS",
+           "ZETA_MIN"]
+
+ZETA_MIN = 0.01  # smallest damping ratio expected: sets the window (the config's envelopes.zeta_min default)
 
 ENVELOPE_COLUMNS = ("time_s", "f_drive_hz", "ref_re", "ref_im", "resp_re", "resp_im", "z_re", "z_im", "h2_amp_g",
                     "h3_amp_g", "noise_g", "drive_on", "bad")  # one row per frame
@@ -44,7 +47,7 @@ class EnvelopeMeta:
     n_drive_on: int
 
 
-def window_length(fs: float, rate: float, f_low: float, *, zeta_min: float = 0.01) -> int:
+def window_length(fs: float, rate: float, f_low: float, *, zeta_min: float = ZETA_MIN) -> int:
     """Window length (samples) for a sweep at `rate` Hz/s sampled at `fs` Hz.
 
     The window must be shorter than the time the sweep takes to cross a half-power
@@ -110,7 +113,7 @@ def _smooth_ridge(t: NDArray, f: NDArray, on: NDArray) -> NDArray:
     return out
 
 
-def envelopes(df: pd.DataFrame, row: dict, *, zeta_min: float = 0.01, hop_fraction: float = 0.25):
+def envelopes(df: pd.DataFrame, row: dict, *, zeta_min: float = ZETA_MIN, hop_fraction: float = 0.25):
     """Envelopes of one run.
 
     Parameters

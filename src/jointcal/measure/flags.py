@@ -3,6 +3,7 @@ its sentence for the log (`FLAG_WORDS`)."""
 from __future__ import annotations
 
 from ..io import UNUSABLE_FLAGS
+from ..io.contract import UNUSABLE
 from .modal import FLAG_WORDS
 
 __all__ = ["run_flags"]
@@ -39,9 +40,9 @@ def run_flags(ingest_flags: str | None, stage_flags: str | None, run_id: str, *,
     flags = list(dict.fromkeys(ingest + [f for f in str(stage_flags or "").split(";") if f]))
     notes = []
     wrong = [f for f in ingest if f.split(":")[0] in UNUSABLE_FLAGS]
-    if wrong and "unusable" not in flags:  # wrong units, level, channels; clipped: no fit
-        flags.append("unusable")
-        notes.append(f"{run_id}: unusable: ingest flagged {', '.join(wrong)} (see the ingest log); "
+    if wrong and UNUSABLE not in flags:  # wrong units, level, channels; clipped: no fit
+        flags.append(UNUSABLE)
+        notes.append(f"{run_id}: {UNUSABLE}: ingest flagged {', '.join(wrong)} (see the ingest log); "
                      "left out of the calibration")
     for flag in [f for f in flags if f.split(":")[0] in FLAG_WORDS or ":" in f]:
         why = f" ({sweep_note})" if flag == "sweep_fit_failed" and sweep_note else ""

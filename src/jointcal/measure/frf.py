@@ -39,7 +39,7 @@ above the peak see the same frozen FRF, and each pair gives its pole without the
 (``backbone_at_peak``: at the peak's amplitude). A fast chirp never builds the steady-state
 amplitude, so it shows the structure at a smaller one.
 
-Reference kinds (`jointcal.io._contract.REFERENCE`): base acceleration (g; the ratio is
+Reference kinds (`jointcal.io.contract.REFERENCE`): base acceleration (g; the ratio is
 the relative displacement z over the base acceleration, modal constant -G in/g),
 force (lbf; receptance x/F) and amplifier voltage (V; x/V is the rig's FRF, the shaker
 included: only its phase and ratios carry information, no damping can be taken from an

@@ -1,7 +1,7 @@
 """Measured modal properties of one run: resonance, damping, amplitude and quality flags.
 
 From a run's envelopes (`jointcal.measure.envelopes`) and its record, by the rule
-`readout_rule` states (one row of modal_properties.csv):
+`READOUT_RULE` states (one row of modal_properties.csv):
 
 * base-driven runs: resonance where the relative displacement z is in quadrature with
   the base acceleration (z leads a_base by 90 deg), corrected for the sweep's lag: a
@@ -33,14 +33,15 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..io._contract import LEVEL, REFERENCE, RESPONSE, excitation_kind
+from ..io.contract import LEVEL, REFERENCE, RESPONSE, UNUSABLE, excitation_kind
 from ..units import G
 from ._envelope_readout import EDGE, envelope_estimates
 from ._excited import REFIT, SWEEP_FRAME, ZETA_MAX, backbone_estimate, excited_readout, modal_constant, sweep_estimate
 from .envelopes import ENVELOPE_COLUMNS, envelopes
 from .frf import ModeFit, frf_flags, quadrature_ok, record_frf, zeta_at_quadrature
+from .sweepfit import WINDOW
 
-__all__ = ["modal_properties", "measure_run", "readout_rule", "FLAG_WORDS", "ENVELOPE_COLUMNS"]
+__all__ = ["modal_properties", "measure_run", "READOUT_RULE", "FLAG_WORDS", "ENVELOPE_COLUMNS"]
 
 
 FLAG_WORDS = {
@@ -54,9 +55,9 @@ FLAG_WORDS = {
     "frf_misfit": "the FRF's peak is not one linear mode (fit residual above frf_misfit: a nonlinear "
                   "structure's bent peak, a transient, overlapping modes or noise); zeta_frf and f_frf_hz are "
                   "doubtful, a quadrature read-out less so",
-    "sweep_truncated": "the record ends with the response still over the fitted window's level (15% of its peak): "
-                       "the free decay that fixes the damping is cut (a real beam record cut 0.5 s after its "
-                       "peak: zeta +1..+11%); record until the response has died out",
+    "sweep_truncated": f"the record ends with the response still over the fitted window's level ({WINDOW:.0%} of "
+                       "its peak): the free decay that fixes the damping is cut (a real beam record cut 0.5 s after "
+                       "its peak: zeta +1..+11%); record until the response has died out",
     "sweep_fit_failed": "the whole-transient fit of one mode did not fit (sweep_note says why); the FRF read-out "
                         "is reported at the band-limited envelope peak, usable only for a quasi-steady sweep",
     "units": "the response/base ratio below resonance says the response is in other units than its column "
@@ -64,7 +65,7 @@ FLAG_WORDS = {
     "no_mode": "the run's band holds none of the modes found in its assembly's runs (jointcal.measure.modes)",
     "dead": "the response does not respond to the drive (an offset and noise: a dead or unplugged sensor; "
             "ingest's check); the run is left out",
-    "unusable": "no resonance could be estimated from this run",
+    UNUSABLE: "no resonance could be estimated from this run",
 }
 
 
@@ -122,7 +123,7 @@ def modal_properties(env: pd.DataFrame, row: dict, *, rate_hz_per_s: float, mass
     -------
     props : dict
         One row of modal_properties.csv: ``f_res_hz``, ``zeta_res`` and ``q_in`` read by
-        the rule of `readout_rule` (``f_res_method`` names it), every estimator's own
+        the rule of `READOUT_RULE` (``f_res_method`` names it), every estimator's own
         columns beside them, ``q_peak_in`` (the response's band-limited envelope peak near
         the mode, the check of q_in) and ``flags``.
     frf : DataFrame (only with ``with_frf``)
@@ -177,11 +178,12 @@ def _table_row(row: dict, kind: str, env_out: dict, read: dict, eta: float, eta_
     if np.isfinite(eta) and eta > eta_max and method != "sweep_fit":  # the sweep fit needs no steady state
         flags.append("eta_high")
     if method == "none" or (method == "peak" and "resonance_outside_band" in flags):
-        flags.append("unusable")
+        flags.append(UNUSABLE)
     out.update(env_out, f_res_hz=float(f_res), f_res_method=method, eta=float(eta))
     return out
 
 
+# the rule that picks each run's (f_res_hz, zeta_res, q_in), in words (raw_data/README.md quotes it)
 READOUT_RULE = (
     "Force- and voltage-driven runs: the swept-mode fit of the whole transient (sweep_fit) wherever it fits "
     f"(misfit <= modal.sweep_misfit, damping in (0, {ZETA_MAX:g}), resonance inside the band and within "
@@ -196,11 +198,6 @@ READOUT_RULE = (
     "quadrature_slope beyond eta_max) at the envelopes' amplitude there, or the FRF fit's quadrature beyond "
     "eta_frf (frf_fit), with the phase-resonance damping; the envelope peak (peak) where the phase never "
     "reaches quadrature.")
-
-
-def readout_rule() -> str:
-    """The rule that picks each run's (f_res_hz, zeta_res, q_in), in words (the contract quotes it)."""
-    return READOUT_RULE
 
 
 def _base_readout(env_out, fit, flags, eta, rate_hz_per_s, eta_frf, frf_misfit):

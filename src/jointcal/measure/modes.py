@@ -33,6 +33,8 @@ import pandas as pd
 from numpy.typing import NDArray
 from scipy import signal
 
+from ..io.contract import UNUSABLE
+
 __all__ = ["modal_peaks", "track_modes", "mode_name", "with_modes", "units", "PROMINENCE", "GAP", "PHASE_TURN_DEG",
            "COHERENCE"]
 
@@ -198,7 +200,7 @@ def units(table: pd.DataFrame) -> list[tuple[str, str]]:
     t = t[t["mode"] != ""]
     level = level_column(t.columns)
     f = pd.to_numeric(t.get("f_res_hz", pd.Series(np.nan, index=t.index)), errors="coerce")
-    usable = t[~t["flags"].fillna("").astype(str).str.contains("unusable") & np.isfinite(f)]
+    usable = t[~t["flags"].fillna("").astype(str).str.contains(UNUSABLE) & np.isfinite(f)]
     out = []
     for asm, g in t.groupby("assembly", sort=False):
         u = usable[usable["assembly"] == asm]

@@ -1,7 +1,5 @@
 """Small read-outs every measurement shares, each written once.
 
-* `parabola_vertex`: the vertex of the parabola through three samples around a peak
-  (a spectral peak on the log magnitude, an envelope's peak on its magnitude).
 * `half_power_lines` and `half_power`: the lines where a peak falls below 1/sqrt(2) of
   its height on each side, and the half-power frequencies interpolated between lines.
 * `anchored_phase` and `phase_crossing`: an unwrapped phase moved by whole turns so that
@@ -15,34 +13,12 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
-__all__ = ["parabola_vertex", "half_power_lines", "half_power", "anchored_phase", "phase_crossing",
+__all__ = ["half_power_lines", "half_power", "anchored_phase", "phase_crossing",
            "full_drive", "transmissibility", "envelope"]
 
 FULL_DRIVE = 0.8  # frames whose reference is at least this fraction of its median are at full drive
-
-
-def parabola_vertex(a: ArrayLike, b: ArrayLike, c: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Offset and height of the vertex of the parabola through (-1, a), (0, b), (1, c).
-
-    Parameters
-    ----------
-    a, b, c : array_like, one shape
-        Three equally spaced samples around a peak (b the middle one).
-
-    Returns
-    -------
-    delta : ndarray
-        The vertex's offset from the middle sample, in sample spacings; 0 where the three
-        samples do not curve downwards (no peak).
-    height : ndarray
-        The parabola's value at the vertex, ``b - (a - c) delta / 4``.
-    """
-    a, b, c = (np.asarray(v, dtype=np.float64) for v in (a, b, c))
-    den = a - 2 * b + c
-    delta = np.where(den < 0, 0.5 * (a - c) / np.where(den < 0, den, -1.0), 0.0)
-    return delta, b - 0.25 * (a - c) * delta
 
 
 def half_power_lines(a: NDArray[np.float64], ip: int) -> tuple[int | None, int | None]:

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..io._contract import level_column
+from ..io.contract import UNUSABLE, level_column
 
 __all__ = ["scatter"]
 
@@ -21,7 +21,7 @@ def scatter(table: pd.DataFrame) -> pd.DataFrame:
     ring-down's row is its own largest window, none a repeat of another.
     """
     level = level_column(table.columns) or "level_g"
-    ok = ~table["flags"].fillna("").str.contains("unusable")
+    ok = ~table["flags"].fillna("").str.contains(UNUSABLE)
     if "f_res_method" in table.columns:
         ok &= ~table["f_res_method"].isin(["dwell", "ringdown"])
     keys = ["assembly", "mode"] if "mode" in table.columns else ["assembly"]

@@ -85,7 +85,9 @@ from ._coil_fit import refit_with_coil
 from ._rotating import baseband, demodulate, head_end, passage
 from ._sweep_problem import Problem, earned_terms, fit_from_starts
 
-__all__ = ["SweepFit", "baseband", "fit_swept_mode"]
+__all__ = ["SweepFit", "baseband", "fit_swept_mode", "WINDOW"]
+
+WINDOW = 0.15  # the fitted stretch: where the response's envelope exceeds this fraction of its peak
 
 
 @dataclass(frozen=True)
@@ -146,7 +148,7 @@ class SweepFit:
 
 
 def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: float, *,
-                   modal_phase: float | None = None, window: float = 0.15, cutoff: float = 0.45,
+                   modal_phase: float | None = None, window: float = WINDOW, cutoff: float = 0.45,
                    steps_per_cycle: float = 6.0, quiet: float = 0.02, ridge: float = 0.01,
                    curv: float = 0.3, residual_ridge: float = 0.3,
                    frequency_curvature: str = "bic", earn: float = 1.5,
@@ -174,7 +176,7 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
     window : float
         Samples of the contiguous stretch around the response's peak whose envelope
         exceeds this fraction of the peak are fitted (the passage through resonance and
-        the ring-down).
+        the ring-down); default `WINDOW`.
     cutoff : float
         Low-pass of the demodulated signals, as a fraction of f0: other modes must lie
         further than this from f0 (0.45: beyond 0.55 f0 and 1.45 f0; a mode within is

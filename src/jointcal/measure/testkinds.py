@@ -22,12 +22,12 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..io._contract import LEVEL, REFERENCE, RESPONSE
+from ..io.contract import LEVEL, REFERENCE, RESPONSE, UNUSABLE
 from ..io._kinds import DWELL
+from ..spectral import peak_frequency
 from ..units import G
 from .dwell import dwell_mode, dwell_point
 from .modes import mode_name
-from .peaks import parabola_vertex
 from .ringdown import decay_start, ringdown_backbone
 
 __all__ = ["other_kinds_modal", "backbone_table", "BACKBONE_COLUMNS", "MIN_DECAY_S", "NEAR"]
@@ -39,7 +39,7 @@ IDENTITY = ("run_id", "assembly", "sequence", "direction")
 
 
 def _peak_hz(x: np.ndarray, fs: float, lo: float = 0.5, decay: bool = False) -> float:
-    """The largest spectral peak of `x` above `lo` Hz (8x zero padding, parabola on the log).
+    """The largest spectral peak of `x` above `lo` Hz (`jointcal.spectral.peak_frequency`, 8x zero padding).
 
     A decay is cut where it last stands 20x over its tail's median (the noise) and read without a
     window (it tapers itself); any other record under a Hann window.
@@ -48,14 +48,7 @@ def _peak_hz(x: np.ndarray, fs: float, lo: float = 0.5, decay: bool = False) -> 
         a = np.abs(x - np.median(x))
         noise = np.median(a[-max(a.size // 10, 1):])
         x = x[:max(int(np.flatnonzero(a > 20 * noise)[-1]) + 1 if (a > 20 * noise).any() else a.size, 64)]
-    y = (x - x.mean()) * (1.0 if decay else np.hanning(x.size))
-    n = 8 * x.size
-    mag = np.abs(np.fft.rfft(y, n))
-    mag[: int(np.ceil(lo * n / fs)) + 1] = 0.0
-    k = int(np.argmax(mag))
-    if 0 < k < mag.size - 1:
-        k = k + float(parabola_vertex(*np.log(mag[k - 1:k + 2] + 1e-300))[0])
-    return float(k * fs / n)
+    return peak_frequency(x, fs, pad=8, window=not decay, lo=lo)
 
 
 def _decay(resp: np.ndarray, ref: np.ndarray, fs: float) -> int | None:
@@ -178,7 +171,7 @@ def other_kinds_modal(rows: list[dict], records: dict, kind: str, swept: dict[st
             top = w.loc[w["q_in"].idxmax()]
             out.update(f_res_hz=top["f_hz"], zeta_res=top["zeta"], q_in=top["q_in"], f_res_method="ringdown")
         else:
-            flags += (r["dwell"]["fit"]["flags"] if r.get("dwell") else ["no_decay"]) + ["unusable"]
+            flags += (r["dwell"]["fit"]["flags"] if r.get("dwell") else ["no_decay"]) + [UNUSABLE]
         if w is not None and len(w):
             out["ringdown_windows"] = len(w)
             out["ringdown_decades"] = float(np.log10(w["q_in"].max() / w["q_in"].min()))
@@ -193,7 +186,7 @@ def backbone_table(modal: pd.DataFrame, points: list[dict]) -> pd.DataFrame:
 
     The rows flagged ``unusable`` are left out; the order is the modal table's runs, windows in time order.
     """
-    usable = ~modal["flags"].fillna("").str.contains("unusable")
+    usable = ~modal["flags"].fillna("").str.contains(UNUSABLE)
     method = modal["f_res_method"] if "f_res_method" in modal else pd.Series("", index=modal.index)
     sweep = ~method.isin(["dwell", "ringdown"])
     rows = modal.loc[usable & sweep]

@@ -93,7 +93,7 @@ def element_table(elements: Sequence[Element], batch: Callable[[ArrayLike], NDAr
     """The kernels' table: codes (n,) sorted, and coefficients (n, 2), or (P, n, 2) with `batch`.
 
     batch : maps a coefficient (scalar or batched model field) to its values over the P
-    parameter sets, shape (P,) (`envelope._field`); None takes scalars.
+    parameter sets, shape (P,) (`envelope.batch_field`); None takes scalars.
     """
     order = sorted(range(len(elements)), key=lambda i: elements[i].code)
     codes = np.array([elements[i].code for i in order], dtype=np.int64)

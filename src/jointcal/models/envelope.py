@@ -23,6 +23,11 @@ Every named effect (`jointcal.effects`) enters here and in the time integrator f
 same fields of `MinistackModel`: the structure (`_structure_terms`), the sensor, and the
 element table of the joint DOF (`jointcal.models.elements`), whose describing functions
 are inline functions of `_envelope_kernel` (one per kind of element).
+
+The swept models (`jointcal.models.swept`, `jointcal.models.swept_integrated`) build on the
+same batch: `batch_shape` and `batch_field` (a model's fields over P parameter sets),
+`joint_terms` (the kernels' joint parameters), `sweep_amplitudes` (the continuation along a
+sweep) and the quadrature `GAUSS_NODES`, `GAUSS_WEIGHTS`.
 """
 from __future__ import annotations
 
@@ -37,13 +42,13 @@ from ..units import G
 from .amplitude import _J
 from .elements import FIRST_HARMONIC, NAMES, element_table
 from .iwan import derived
-from .structure import MinistackModel, Neighbour
+from .structure import MinistackModel, Neighbour, can_spring
 
-__all__ = ["SteadyState", "steady_state"]
+__all__ = ["SteadyState", "steady_state", "batch_shape", "batch_field", "joint_terms", "sweep_amplitudes",
+           "GAUSS_NODES", "GAUSS_WEIGHTS"]
 
-_NODES, _WEIGHTS = np.polynomial.legendre.leggauss(16)
-_NODES = 0.5 * (_NODES + 1.0)
-_WEIGHTS = 0.5 * _WEIGHTS
+_X, _W = np.polynomial.legendre.leggauss(16)
+GAUSS_NODES, GAUSS_WEIGHTS = 0.5 * (_X + 1.0), 0.5 * _W  # 16-point Gauss-Legendre on [0, 1], the kernels' quadrature
 TOL = 1e-10  # convergence of s = log q: 1e-10 relative in amplitude
 
 
@@ -72,13 +77,13 @@ class SteadyState:
     jump: NDArray[np.bool_]
 
 
-def _field(value, shape) -> NDArray[np.float64]:
+def batch_field(value, shape) -> NDArray[np.float64]:
     """A model field broadcast to the parameter batch (P,) (constant along frequency)."""
     a = np.broadcast_to(np.asarray(value, dtype=float), shape)
     return np.ascontiguousarray(a.reshape(-1, shape[-1])[:, 0])
 
 
-def _batch_shape(model: MinistackModel, f_shape: tuple) -> tuple[tuple[int, int], tuple]:
+def batch_shape(model: MinistackModel, f_shape: tuple) -> tuple[tuple[int, int], tuple]:
     """(P, N) of a model's parameter batch along frequencies of shape f_shape, and the broadcast output shape."""
     iw = model.iwan
     fields = [model.m, model.k, model.zeta_v, model.sensor_gain, model.sensor_delay_s]
@@ -91,7 +96,7 @@ def _batch_shape(model: MinistackModel, f_shape: tuple) -> tuple[tuple[int, int]
     return (int(np.prod(out_shape[:-1], dtype=int)), out_shape[-1]), out_shape
 
 
-def _joint_terms(model: MinistackModel, shape) -> tuple[NDArray, ...]:
+def joint_terms(model: MinistackModel, shape) -> tuple[NDArray, ...]:
     """The joint DOF's kernel parameters: k, c, KT, R, chi, phi_max, S, J(chi, 1), each (P,), and the
     element table: codes (n_e,), coefficients (P, n_e, 2).
 
@@ -99,8 +104,8 @@ def _joint_terms(model: MinistackModel, shape) -> tuple[NDArray, ...]:
     parameters (`iwan.derived`); a linear model has KT = 0.
     """
     P = shape[0]
-    m, k, zv = (_field(v, shape) for v in (model.m, model.k, model.zeta_v))
-    codes, coefs = element_table(model.elements, lambda v: _field(v, shape))
+    m, k, zv = (batch_field(v, shape) for v in (model.m, model.k, model.zeta_v))
+    codes, coefs = element_table(model.elements, lambda v: batch_field(v, shape))
     iw = model.iwan
     if iw is None:
         KT = np.zeros(P)
@@ -108,18 +113,18 @@ def _joint_terms(model: MinistackModel, shape) -> tuple[NDArray, ...]:
         chi = np.full(P, -0.5)
         phimax = np.ones(P)
     else:
-        Fs, KT, chi, beta = (_field(v, shape) for v in (iw.Fs, iw.KT, iw.chi, iw.beta))
+        Fs, KT, chi, beta = (batch_field(v, shape) for v in (iw.Fs, iw.KT, iw.chi, iw.beta))
         phimax, R, S = derived(Fs, KT, chi, beta)
         J1 = _J(chi, np.ones_like(chi))
     c = 2.0 * zv * np.sqrt((k + KT) * m)
     return k, c, KT, R, chi, phimax, S, J1, codes, coefs
 
 
-def _amplitudes(f: NDArray, A: NDArray, direction: str, shape, joint, m: NDArray, mu: NDArray,
-                gamma: NDArray | None) -> tuple[NDArray, ...]:
+def sweep_amplitudes(f: NDArray, A: NDArray, direction: str, shape, joint, m: NDArray, mu: NDArray,
+                     gamma: NDArray | None) -> tuple[NDArray, ...]:
     """The kernel's continuation along the sweep: s = log q, jump flags and K_z = kre + i kim, each (P, N).
 
-    joint : `_joint_terms`; m (P,); mu (P, N) and gamma (P, N) or None (rigid base) from
+    joint : `joint_terms`; m (P,); mu (P, N) and gamma (P, N) or None (rigid base) from
     `_structure_terms`; A (N,) base amplitude, in/s^2.
     """
     P = shape[0]
@@ -141,8 +146,8 @@ def _amplitudes(f: NDArray, A: NDArray, direction: str, shape, joint, m: NDArray
     mu_re = np.ascontiguousarray(mu.real)
     mu_im = np.zeros_like(mu_re) if rigid else np.ascontiguousarray(mu.imag)
     solver(w, mu_re, mu_im, np.ascontiguousarray(np.broadcast_to(logB, (P, f.size))), s0,
-           order.astype(np.int64), k, c, KT, R, chi, phimax, S, J1, codes, coefs, _NODES, _WEIGHTS, TOL, s, jump,
-           kre, kim)
+           order.astype(np.int64), k, c, KT, R, chi, phimax, S, J1, codes, coefs, GAUSS_NODES, GAUSS_WEIGHTS, TOL,
+           s, jump, kre, kim)
     return s, jump, kre, kim
 
 
@@ -154,13 +159,12 @@ def _structure_terms(model: MinistackModel, w: NDArray, shape) -> tuple[NDArray,
     the can's row, a11 = k_can + i omega c_can - omega^2 (m_can + m), gives
     mu = omega^2 m (1 + omega^2 m / a11) and gamma = (k_can + i omega c_can) / a11.
     """
-    m = _field(model.m, shape)[:, None]
+    m = batch_field(model.m, shape)[:, None]
     if model.fixture is None:
         return m * w**2, None  # real inertia, unit load factor
     fx = model.fixture
-    m_can = _field(fx.m_can, shape)[:, None]
-    k_can = m_can * (2 * np.pi * _field(fx.f_can, shape)[:, None]) ** 2
-    c_can = 2.0 * _field(fx.zeta_can, shape)[:, None] * np.sqrt(k_can * m_can)
+    m_can = batch_field(fx.m_can, shape)[:, None]
+    k_can, c_can = can_spring(m_can, batch_field(fx.f_can, shape)[:, None], batch_field(fx.zeta_can, shape)[:, None])
     kc = k_can + 1j * w * c_can
     a11 = kc - w**2 * (m_can + m)
     return w**2 * m * (1.0 + w**2 * m / a11), kc / a11
@@ -215,17 +219,17 @@ def steady_state(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike = 1.0
     solution, not a grid value; dashpot convention as `harmonic_balance(viscous="dashpot")`.
     """
     f, A = _checked(model, f_hz, base_g, direction)
-    shape, out_shape = _batch_shape(model, f.shape)
+    shape, out_shape = batch_shape(model, f.shape)
     P = shape[0]
     w = 2 * np.pi * f
-    m = _field(model.m, shape)
+    m = batch_field(model.m, shape)
     mu, gamma = _structure_terms(model, w, shape)
     rigid = model.fixture is None  # gamma = 1, mu real: skip the complex work
-    s, jump, kre, kim = _amplitudes(f, A, direction, shape, _joint_terms(model, shape), m, mu, gamma)
+    s, jump, kre, kim = sweep_amplitudes(f, A, direction, shape, joint_terms(model, shape), m, mu, gamma)
     mu_re = np.ascontiguousarray(mu.real)
     q = np.exp(s)
-    gain = _field(model.sensor_gain, shape)
-    tau = _field(model.sensor_delay_s, shape)
+    gain = batch_field(model.sensor_gain, shape)
+    tau = batch_field(model.sensor_delay_s, shape)
     if rigid:
         Z = np.empty((P, f.size), complex)
         T = np.empty((P, f.size), complex)
@@ -236,15 +240,15 @@ def steady_state(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike = 1.0
         Z = -gamma * m[:, None] * A / (Kz - mu)
         # absolute slug acceleration: a_b - omega^2 (W + Z); the can's motion W from its row
         fx = model.fixture
-        m_can = _field(fx.m_can, shape)[:, None]
-        k_can = m_can * (2 * np.pi * _field(fx.f_can, shape)[:, None]) ** 2
-        c_can = 2.0 * _field(fx.zeta_can, shape)[:, None] * np.sqrt(k_can * m_can)
+        m_can = batch_field(fx.m_can, shape)[:, None]
+        k_can, c_can = can_spring(m_can, batch_field(fx.f_can, shape)[:, None],
+                                  batch_field(fx.zeta_can, shape)[:, None])
         a11 = k_can + 1j * w * c_can - w**2 * (m_can + m[:, None])
         W = (-(m_can + m[:, None]) * A + w**2 * m[:, None] * Z) / a11  # can row: a11 W - omega^2 m Z = -(m_can+m) A
         T = gain[:, None] * (1.0 - w**2 * (W + Z) / A) * np.exp(-1j * w * tau[:, None])
     nb = model.neighbour
     if nb is not None:  # a neighbouring linear mode the response channel also reads (`structure.Neighbour`)
         T = T + gain[:, None] * np.exp(-1j * w * tau[:, None]) * Neighbour(
-            _field(nb.f_hz, shape)[:, None], _field(nb.ratio, shape)[:, None], _field(nb.zeta, shape)[:, None]).frf(f)
+            batch_field(nb.f_hz, shape)[:, None], batch_field(nb.ratio, shape)[:, None], batch_field(nb.zeta, shape)[:, None]).frf(f)
     return SteadyState(T.reshape(out_shape), Z.reshape(out_shape), q.reshape(out_shape), jump.reshape(out_shape))
 

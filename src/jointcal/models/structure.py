@@ -24,12 +24,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from .elements import Element
 from .iwan import IwanParams
 
-__all__ = ["Neighbour", "Fixture", "MinistackModel", "StateSpace", "state_space"]
+__all__ = ["Neighbour", "Fixture", "can_spring", "MinistackModel", "StateSpace", "state_space"]
 
 
 @dataclass(frozen=True)
@@ -43,6 +43,25 @@ class Fixture:
     m_can: float
     f_can: float
     zeta_can: float = 0.01
+
+
+def can_spring(m_can: ArrayLike, f_can: ArrayLike,
+               zeta_can: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The fixture can's spring k_can = m_can (2 pi f_can)^2 (lbf/in) and dashpot c_can = 2 zeta_can sqrt(k_can m_can).
+
+    Parameters
+    ----------
+    m_can, f_can, zeta_can : float or array_like, broadcast together
+        The can's moving mass (lbf s^2/in), its own frequency on its spring with the slug
+        removed (Hz) and its viscous damping ratio (`Fixture`), one per parameter set.
+
+    Returns
+    -------
+    k_can, c_can : ndarray
+        Stiffness (lbf/in) and dashpot (lbf s/in), of the broadcast shape.
+    """
+    k_can = m_can * (2 * np.pi * f_can) ** 2
+    return k_can, 2.0 * zeta_can * np.sqrt(k_can * m_can)
 
 
 @dataclass(frozen=True)
@@ -162,8 +181,7 @@ def state_space(model: MinistackModel) -> StateSpace:
         ez = np.array([1.0])
     else:
         fx = model.fixture
-        k_can = fx.m_can * (2 * np.pi * fx.f_can) ** 2
-        c_can = 2.0 * fx.zeta_can * np.sqrt(k_can * fx.m_can)
+        k_can, c_can = can_spring(fx.m_can, fx.f_can, fx.zeta_can)
         M = np.array([[fx.m_can + m, m], [m, m]])
         K = np.diag([k_can, ks])
         C = np.diag([c_can, c])

@@ -60,7 +60,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _envelope_kernel as _k
 from ..units import G
-from .envelope import _NODES, _WEIGHTS, _amplitudes, _batch_shape, _field, _joint_terms
+from .envelope import (  # envelope's public batch API, under this module's short names
+    GAUSS_NODES as _NODES, GAUSS_WEIGHTS as _WEIGHTS, batch_field as _field, batch_shape as _batch_shape,
+    joint_terms as _joint_terms, sweep_amplitudes as _amplitudes,
+)
 from .structure import MinistackModel, Neighbour
 
 __all__ = ["SweepDrive", "quasi_steady", "quasi_steady_runs", "sweep_eta", "CAP"]

@@ -13,7 +13,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _envelope_kernel as _k
 from ..units import G
-from .envelope import _NODES, _WEIGHTS, _field, _joint_terms
+from .envelope import GAUSS_NODES, GAUSS_WEIGHTS, batch_field, joint_terms
 from .structure import MinistackModel
 from .swept import SweepDrive, _channel, _derivs, _quasi_steady, sweep_eta
 
@@ -93,11 +93,11 @@ def _integrated(model: MinistackModel, drive: SweepDrive, t_a: float, t_b: float
     p0 = np.ascontiguousarray(-mu + 0.5j * alpha * mu2)
     g0 = np.ascontiguousarray(F * A - 1j * F1 * A * dl - 0.5j * alpha * F2 * A)
     m1 = np.ascontiguousarray(1j * mu1 + 0j)
-    *scalars, codes, coefs = _joint_terms(model, (1, 1))
+    *scalars, codes, coefs = joint_terms(model, (1, 1))
     joint = (*(float(v[0]) for v in scalars), codes, np.ascontiguousarray(coefs[0]))
     force = np.empty(n, complex)
-    _k.slow_flow(complex(Z[0, -1]), h, w, alpha, p0, g0, m1, *joint, _NODES, _WEIGHTS, force)
-    m = float(_field(model.m, (1, 1))[0])
+    _k.slow_flow(complex(Z[0, -1]), h, w, alpha, p0, g0, m1, *joint, GAUSS_NODES, GAUSS_WEIGHTS, force)
+    m = float(batch_field(model.m, (1, 1))[0])
     tn, Rn, An = th[::2], -force / m, A[::2]
     L = drive.window_s
     out = np.empty(t_out.size, complex)

@@ -27,22 +27,28 @@ posterior spread comes from, with a local Laplace approximation at each posterio
 """
 from __future__ import annotations
 
+import json
+import os
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
+from ..calibrate.data import read_modal
 from ..calibrate.objective import predict
-from ..calibrate.settings import JOINT
+from ..calibrate.settings import JOINT, CalibrateSettings
 from ..calibrate.space import ParamSpace
+from ..io import write_csv_atomic
 from ..models import derived, dissipation
 from .fisher import PRIOR_PRECISION, fisher, fixed_directions, free_share, unit_jacobian
+from .settings import PosteriorSettings
 
 __all__ = ["Quantity", "quantities", "unit_jacobian", "fisher", "free_share", "fixed_directions",
-           "identified_table", "identified_at", "unsettled", "settled", "PRIOR_PRECISION"]
+           "identified_table", "identified_at", "unsettled", "settled", "write_identified", "PRIOR_PRECISION"]
 
 
 
@@ -282,3 +288,24 @@ def settled(table: pd.DataFrame) -> pd.DataFrame:
         return table
     why = table["why_not"].fillna("").astype(str)
     return table.assign(identified=table["identified"].astype(bool) & (why == ""), why_not=why)
+
+
+def write_identified(modal_csv: str | os.PathLike[str], ga_best_json: str | os.PathLike[str],
+                   chain_npz: str | os.PathLike[str], assembly: str, cal: CalibrateSettings, ps: PosteriorSettings,
+                   out_csv: str | os.PathLike[str]) -> str:
+    """Write ``identified.csv``, the posterior stage's last output, from the chain it wrote (`identified_table`).
+
+    Which parameters and combinations the data identify, from the draws in `chain_npz`, with the
+    reason when the chain has not settled (`unsettled`). Returns a line for the log.
+    """
+    cal = cal.resolved(json.loads(Path(ga_best_json).read_text()))
+    data = read_modal(modal_csv, assembly, damping=cal.damping)
+    with np.load(chain_npz) as z:
+        names = [str(n) for n in z["sample_names"]]
+        why_not = unsettled({k: z[k] for k in z.files}, names, tau_factor=ps.tau_factor)
+        table, _ = identified_table(z["samples"], names, cal.space, data.q, data.f, data.zeta, m=cal.m,
+                                    model=cal.model, viscous=cal.viscous, ratio=ps.constrained_ratio,
+                                    why_not=why_not)
+    write_csv_atomic(table, out_csv)
+    return ("identified: " + ", ".join(table.loc[table["identified"], "quantity"]) + "; left to the bounds: "
+            + ", ".join(table.loc[~table["identified"], "quantity"]) + (f" ({why_not})" if why_not else ""))

@@ -9,7 +9,7 @@ and every tau changed by less than ``tau_rtol`` since the previous chunk, or at
 
 Early stop (``stop_projected``): a chain whose autocorrelation time keeps growing with
 its length (walkers that do not mix, e.g. between separated modes) never reaches the
-50-tau rule. After ``min_chunks`` checks, the chain length in units of tau, r = N / tau,
+tau_factor rule. After ``min_chunks`` checks, the chain length in units of tau, r = N / tau,
 is extrapolated linearly over the last three checks to the N where it reaches
 ``tau_factor`` (`projected_steps`). For a chain that mixes, tau settles and r grows at
 1/tau per step, so the projection is about tau_factor * tau; for one that does not, r
@@ -44,9 +44,9 @@ class ChainResult:
     tau : ndarray (ndim [+ k],) -- integrated autocorrelation time of each coordinate
     (and observed quantity), steps; tau_history : ndarray (chunks, 1 + len(tau)) -- chain
     length, then tau, after each chunk;
-    converged : bool -- the 50-tau rule was met; stop_reason : str -- "converged",
+    converged : bool -- the tau_factor rule was met; stop_reason : str -- "converged",
     "max_steps" or "projected" (stopped early, see the module notes); projected_steps :
-    float -- the last projection of the steps the 50-tau rule needs (inf: r not growing);
+    float -- the last projection of the steps the tau_factor rule needs (inf: r not growing);
     acceptance : ndarray (walkers,) --
     acceptance fraction over the whole chain; random_state : tuple -- emcee's RandomState.
     """
@@ -226,7 +226,7 @@ def run_chain(log_prob: Callable[[NDArray[np.float64]], NDArray[np.float64]], x0
 
 
 def _converged(hist: list[NDArray[np.float64]], tau_factor: float, tau_rtol: float) -> bool:
-    """The 50-tau rule on the last two convergence checks."""
+    """The tau_factor rule (with tau_rtol) on the last two convergence checks."""
     if len(hist) < 2:
         return False
     (n, *tau), (_, *prev) = hist[-1], hist[-2]

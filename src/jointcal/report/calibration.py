@@ -20,9 +20,9 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from ..calibrate.space import LOG_SCALED, PARAMS
-from .summary import fmt
+from .summary import bound_hits, fmt, rst_escape
 
-__all__ = ["amplitude_figure", "exploration_figure", "convergence_figure"]
+__all__ = ["amplitude_figure", "exploration_figure", "convergence_figure", "exploration_caption"]
 
 
 def _figure(width: float, height: float, dpi: float = 110):
@@ -197,3 +197,35 @@ def convergence_figure(logbooks: Mapping[str, pd.DataFrame]) -> bytes:
     ax.legend(fontsize=8)
     fig.tight_layout()
     return _png(fig)
+
+
+def exploration_caption(history: pd.DataFrame, best: Mapping, ga: Mapping[str, float], polished: Mapping[str, float],
+                        bounds: Mapping[str, tuple[float, float]]) -> str:
+    """The run-generated part of the GA figures' caption (reStructuredText): this run, bounds hit, macroslip.
+
+    Parameters
+    ----------
+    history : DataFrame
+        ``ga_history.csv`` (one row per evaluation).
+    best : mapping
+        ``ga_best.json`` (``generations``, ``stop_reason``, ``objective``, ``q_max_in``, ``phi_max_in``).
+    ga, polished : mapping
+        The GA's best point and the polished optimum (`PARAMS` and ``objective``).
+    bounds : mapping
+        The search bounds, name -> (lower, upper).
+    """
+    lines = [f"**This run** ({len(history)} evaluations, {best['generations']} generations, stopped by "
+             f"{rst_escape(str(best['stop_reason']))}): GA best objective {fmt(ga['objective'])} at "
+             + ", ".join(f"{rst_escape(p)} {fmt(ga[p])}" for p in PARAMS)
+             + f"; polished optimum objective {fmt(best['objective'])} at "
+             + ", ".join(f"{rst_escape(p)} {fmt(best[p])}" for p in PARAMS) + "."]
+    for label, point in (("GA best", ga), ("polished optimum", polished)):
+        hits = bound_hits(point, bounds)
+        if hits:
+            lines.append(f"**At a search bound** ({label}): " + ", ".join(
+                f"{rst_escape(p)} at its {side} bound {fmt(bounds[p][0 if side == 'lower' else 1])}"
+                for p, side in hits.items()) + ".")
+    if best["q_max_in"] >= best["phi_max_in"]:
+        lines.append(f"The polished optimum puts macroslip (phi\\_max {fmt(best['phi_max_in'])} in) inside the "
+                     f"measured amplitudes (up to {fmt(best['q_max_in'])} in).")
+    return "\n\n".join(lines) + "\n"

@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 
 from ..io import level_column
+from ..io.contract import UNUSABLE
 
 __all__ = ["steady_frames", "plot_envelopes", "plot_frequency_damping", "plot_spectrogram"]
 
@@ -88,7 +89,7 @@ def plot_frequency_damping(table: pd.DataFrame, path) -> None:
         else ["assembly"]  # one series per assembly, or per assembly and mode where one has several
     for i, (key, g) in enumerate(table.groupby(keys, sort=False)):
         asm, c = " ".join(map(str, key)), f"C{i}"
-        bad = g["flags"].fillna("").str.contains("unusable")
+        bad = g["flags"].fillna("").str.contains(UNUSABLE)
         g = g[~bad]
         a1.semilogx(g["q_in"], g["f_res_hz"], "o", color=c, label=f"{asm}")
         a2.semilogx(g["q_in"], 100 * g["zeta_phase_resonance"], "o", color=c, label=f"{asm}: phase resonance")

@@ -14,7 +14,7 @@ from numpy.typing import ArrayLike
 from ..calibrate.objective import predict
 from ..calibrate.space import PARAMS, UNITS
 
-__all__ = ["table_3_2", "table_3_2_markdown", "qsma_vs_harmonic_balance"]
+__all__ = ["table_3_2", "table_3_2_markdown", "qsma_vs_harmonic_balance", "qsma_at_measured"]
 
 
 def table_3_2(ga_best: Mapping[str, Mapping], summaries: Mapping[str, pd.DataFrame],
@@ -134,3 +134,34 @@ def qsma_vs_harmonic_balance(theta: Mapping[str, float], q: ArrayLike, *, m: flo
     fh, zh = predict(t, q, m=m, model="harmonic_balance", viscous=viscous)  # type: ignore[arg-type]
     return pd.DataFrame({"q_in": q, "f_qsma_hz": fq[0], "f_hb_hz": fh[0], "df_percent": 100 * (fq[0] / fh[0] - 1),
                          "zeta_qsma": zq[0], "zeta_hb": zh[0], "dzeta_percent": 100 * (zq[0] / zh[0] - 1)})
+
+
+def qsma_at_measured(theta: Mapping[str, float], data, assembly: str, *, m: float,
+                     viscous: str = "dashpot") -> pd.DataFrame:
+    """`qsma_vs_harmonic_balance` at one unit's measured amplitudes: the mean q_in of each level.
+
+    Parameters
+    ----------
+    theta : mapping
+        The calibrated joint (as `qsma_vs_harmonic_balance`).
+    data : jointcal.calibrate.ModalData
+        The unit's read-outs (``q``, in; ``level``; ``run_id``).
+    assembly : str
+        The unit's name, the table's first column.
+    m : float
+        Slug mass (or modal mass), lbf s^2/in.
+    viscous : str
+        Viscous convention.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``assembly``, ``level`` (or ``run_id`` where a run has no level: one row per run), then the
+        columns of `qsma_vs_harmonic_balance`.
+    """
+    by_level = pd.notna(data.level).all()
+    q = pd.Series(data.q).groupby(data.level if by_level else list(data.run_id), sort=by_level).mean()
+    t = qsma_vs_harmonic_balance(theta, q.to_numpy(), m=m, viscous=viscous)
+    t.insert(0, "assembly", assembly)
+    t.insert(1, "level" if by_level else "run_id", q.index.to_numpy())
+    return t

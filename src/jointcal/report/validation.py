@@ -12,7 +12,7 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 
-from ..io._contract import LEVEL, excitation_kind
+from ..io.contract import LEVEL, excitation_kind
 from .calibration import _figure, _png
 
 __all__ = ["validation_figure"]

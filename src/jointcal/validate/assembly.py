@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from ..io._contract import LEVEL, excitation_kind
+from ..io.contract import LEVEL, excitation_kind
 from ..models import MinistackModel
 from .error import describe_misfit, envelope_error, repeat_scatter
 from .runs import (band_frames, compare_run, draw_transmissibility, full_drive_fraction, measure_pair,

@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from ..io._contract import LEVEL, REFERENCE, level_column
+from ..io.contract import LEVEL, REFERENCE, level_column
 from ..models import MinistackModel, fractional_delay, simulate
 from ..units import G
 

@@ -32,7 +32,7 @@ import pandas as pd
 from numpy.typing import NDArray
 from scipy.signal.windows import hann
 
-from ..io._contract import LEVEL, REFERENCE, excitation_kind, level_column
+from ..io.contract import LEVEL, REFERENCE, UNUSABLE, excitation_kind, level_column
 from ..measure.modal import measure_run
 from ..measure.peaks import FULL_DRIVE, transmissibility
 from ..measure.peaks import full_drive as full_drive_frames
@@ -112,7 +112,7 @@ def compare_run(env_m: pd.DataFrame, props_m: Mapping, env_s: pd.DataFrame, prop
     f_res = float(props_m["f_res_hz"])
     head = run_head(props_m)
     fd = full_drive_fraction(props_m)
-    if not np.isfinite(f_res) or "unusable" in str(props_m.get("flags", "")):
+    if not np.isfinite(f_res) or UNUSABLE in str(props_m.get("flags", "")):
         return pd.DataFrame(), {**head, "n_frames": 0, "note": "measured run unusable"}
     lo, hi = band[0] * f_res, band[1] * f_res
     use_m = band_frames(env_m, f_res, (0.0, np.inf), full_drive=fd)

@@ -1,7 +1,8 @@
 """The raw-data contract's names and errors, and the one rule that tells a run's excitation.
 
-Private: `jointcal.io` re-exports `CampaignError`, `CampaignWarning`, `excitation_kind`
-and `level_column`.
+Public: the stages after ingest read a record's and a table's columns by these names
+(`REFERENCE`, `RESPONSE`, `LEVEL`, ...) and raise with `fail`. `jointcal.io` re-exports
+`CampaignError`, `CampaignWarning`, `excitation_kind` and `level_column`.
 """
 from __future__ import annotations
 
@@ -10,7 +11,9 @@ from typing import Literal, NoReturn
 
 from jointcal.units import FOOT_IN, G, G_SI, INCH_M, LBF_N
 
-__all__: list[str] = []
+__all__ = ["Excitation", "OnDataProblem", "TIME", "RESPONSE", "REFERENCE", "LEVEL", "RESPONSE_SI", "TEXT", "START",
+           "CHANNEL_COLUMNS", "POSITIVE", "QUANTITY", "UNITS", "SI_UNIT", "FS_RTOL", "MIN_CYCLES", "CampaignError",
+           "CampaignWarning", "fail", "excitation_kind", "level_column", "excitation_of", "UNUSABLE"]
 
 Excitation = Literal["base", "force", "voltage"]
 OnDataProblem = Literal["error", "flag"]
@@ -44,6 +47,7 @@ SI_UNIT: dict[str, str] = {"acceleration": "m/s^2", "force": "N", "voltage": "V"
                            "displacement": "m"}
 FS_RTOL = 1e-3  # allowed relative sample-rate disagreement with the manifest
 MIN_CYCLES = 20  # cycles of the lowest drive frequency in each frequency window
+UNUSABLE = "unusable"  # the flag of a run (modal_properties.csv flags) that the later stages leave out
 
 
 class CampaignError(ValueError):

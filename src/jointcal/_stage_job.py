@@ -1,0 +1,111 @@
+"""The frame of a workflow stage's script: its log, its warnings, its one-sentence exit and its pool.
+
+A stage script (``workflow/scripts/<stage>.py``) is one block::
+
+    with stage_job(snakemake) as job:
+        notes = run_<stage>(..., progress=job.log)
+        job.log(...)
+
+`stage_job` opens the rule's log line-buffered (progress can be read while the job runs) and
+closes it at the end; writes every warning raised inside to the log and to stderr as
+``jointcal: warning: <message>``, as it is raised (under the filters in force: by Python's
+default, a repeat from the same line once, no deprecations); and turns an error of the inputs
+or settings (`ValueError`, of which `jointcal.io.CampaignError` and
+`jointcal.calibrate.CalibrationInputError` are kinds) into its one sentence, after the
+warnings, in the log and on stderr, and a non-zero exit without a traceback. `Job.pool` and
+`Job.map` spread work over ``snakemake.threads`` processes, or run it in this one.
+Imports nothing of the package, so a stage's code hash (`jointcal._workflow.stage_hash`) gains
+only this file.
+"""
+from __future__ import annotations
+
+import sys
+import time
+import warnings
+from collections.abc import Callable, Iterable, Iterator
+from concurrent.futures import Executor, ProcessPoolExecutor
+from contextlib import contextmanager
+from pathlib import Path
+from typing import IO, Any
+
+__all__ = ["Job", "stage_job"]
+
+
+class Job:
+    """A running stage: `log` and `warn` write to its log, `pool` and `map` use its threads.
+
+    Attributes
+    ----------
+    smk : snakemake.script.Snakemake
+        The rule's ``snakemake`` object (input, output, params, wildcards, threads, log).
+    threads : int
+        Processes the job may use (``snakemake.threads``, at least 1).
+    """
+
+    def __init__(self, smk: Any, log_file: IO[str]) -> None:
+        self.smk = smk
+        self.threads = max(1, int(getattr(smk, "threads", 1) or 1))
+        self._file = log_file
+        self._t0 = time.perf_counter()
+
+    @property
+    def elapsed(self) -> float:
+        """Seconds since the job started."""
+        return time.perf_counter() - self._t0
+
+    def log(self, line: str) -> None:
+        """Write ``jointcal: <line>`` to the log (progress, and the result in words)."""
+        self._file.write(f"jointcal: {line}\n")
+
+    def warn(self, line: str) -> None:
+        """Write ``jointcal: warning: <line>`` to the log and to stderr."""
+        self.log(f"warning: {line}")
+        print(f"jointcal: warning: {line}", file=sys.stderr)
+
+    def workers(self, n_tasks: int | None = None) -> int:
+        """Processes for `n_tasks` tasks: the job's threads, at most one per task."""
+        return self.threads if n_tasks is None else max(1, min(self.threads, n_tasks))
+
+    @contextmanager
+    def pool(self, n_tasks: int | None = None) -> Iterator[Executor | None]:
+        """A process pool of `workers` processes, or None (run here) when that is one."""
+        n = self.workers(n_tasks)
+        if n == 1:
+            yield None
+            return
+        with ProcessPoolExecutor(max_workers=n) as ex:
+            yield ex
+
+    def map(self, fn: Callable[..., Any], *iterables: Iterable[Any]) -> list[Any]:
+        """``[fn(*args) for args in zip(*iterables)]``, over the pool when it has more than one process."""
+        tasks = list(zip(*iterables))
+        with self.pool(len(tasks)) as ex:
+            return list(ex.map(fn, *zip(*tasks))) if ex is not None else [fn(*a) for a in tasks]
+
+
+@contextmanager
+def stage_job(smk: Any, *, errors: tuple[type[BaseException], ...] = (ValueError,)) -> Iterator[Job]:
+    """Run a stage script's body as a `Job` (see the module notes).
+
+    Parameters
+    ----------
+    smk : snakemake.script.Snakemake
+        The rule's ``snakemake`` object; its ``log[0]`` is the log written.
+    errors : tuple of exception types, optional
+        The errors that end the job with their one sentence (others keep their traceback).
+
+    Raises
+    ------
+    SystemExit
+        ``jointcal: <the error's sentence>`` on one of `errors`.
+    """
+    log = Path(smk.log[0])
+    log.parent.mkdir(parents=True, exist_ok=True)
+    with open(log, "w", buffering=1) as f, warnings.catch_warnings():
+        job = Job(smk, f)
+        warnings.showwarning = lambda message, *_, **__: job.warn(str(message))
+        try:
+            yield job
+        except errors as exc:
+            job.log(str(exc))
+            sys.exit(f"jointcal: {exc}")
