@@ -19,7 +19,8 @@ from jointcal.discrepancy import EFFECTS, DiscrepancySettings, decide, diagnose,
 from jointcal.discrepancy.data import RunEnvelope
 from jointcal.discrepancy.fit import candidate, envelope_E, model_at, predict
 from jointcal.discrepancy.rule import NONE_E, confirm
-from jointcal.discrepancy.select import Scored, needs_pairs, pair_names
+from jointcal.discrepancy.rule import needs_pairs, pair_names
+from jointcal.discrepancy.select import Scored
 from jointcal.discrepancy.stage import valley_starts
 from jointcal.models import G
 

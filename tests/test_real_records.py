@@ -4,7 +4,8 @@ The UNESP-BERT bolted beam's mode 1 (six voltage-driven up chirps at eta 200-600
 Ilha Solteira, non-commercial research use) lives outside this repository, in
 ../shared/real/unesp-bert-mode1 beside it, and is never copied in. The whole workflow runs on it
 with the default config: the model kind follows the excitation (one mode, per unit modal mass, its
-bounds from the data), and the calibrated curve passes within 0.2% of every run's (q_in, f_res_hz).
+bounds from the data), the calibrated curve passes within 0.2% of every run's (q_in, f_res_hz), and the
+discrepancy stage tries the modal library on it.
 """
 from __future__ import annotations
 
@@ -52,7 +53,11 @@ def test_a_voltage_driven_real_campaign_runs_end_to_end_with_the_default_config(
     assert np.isfinite(summary["E"]) and "modal constant" in summary["words"]
     assert any((out / "validation" / "bert_5Nm" / "m18" / "envelopes" / "traces").glob("*.csv"))
     assert "per unit modal mass" in (out / "posterior" / "bert_5Nm" / "m18" / "constraints.txt").read_text()
-    assert not (out / "discrepancy").exists()  # the base-driven rig's library is not run on a voltage campaign
+    diag = json.loads((out / "discrepancy" / "bert_5Nm" / "m18" / "diagnosis.json").read_text())
+    assert diag["model_kind"] == "modal" and diag["level_unit"] == "V"  # the modal library, on the voltage drive
+    assert "sensor_gain" not in {c["name"] for c in diag["candidates"]}
+    print(f"discrepancy: {diag['effect']} ({diag['confidence']}), E {diag['metric_before']:.3g} -> "
+          f"{diag['metric_after']:.3g}, floor {diag['fast_model_floor']['E']}, {diag['seconds']:.0f} s")
     # the verdict's first answer agrees with the chi-square it shows (and with E): Yes only when both pass
     page = (out / "report" / "summary.html").read_text()
     answer = re.search(r"reproduce the measured envelopes\?</b> <b>(Yes|No)</b>", page).group(1)

@@ -1,4 +1,5 @@
-"""The decision on the held-out scores (`select`): a name, 'none' or 'unexplained', and the rule's own words.
+"""The decision on the held-out scores (`select`): a name, 'none' or 'unexplained', and the rule's own words;
+and when forward selection goes on to pairs, and which (`needs_pairs`, `pair_bases`, `pair_names`).
 
 The rule is written once, clause by clause (`CLAUSES`, joined into `RULE`): `decide` and
 `confirm` name the clauses they applied (`Decision.applied`), so the text diagnosis.json
@@ -12,13 +13,13 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from ..effects import EFFECTS, effects_of
+from ..effects import EFFECTS, JOIN, effects_of
 
 if TYPE_CHECKING:
     from .select import Scored
 
 __all__ = ["NONE_E", "CLOSE_FRACTION", "MARGIN", "WITHIN_SCATTER", "FLOOR_HIGH", "CLAUSES", "RULE", "Decision",
-           "decide", "confirm"]
+           "decide", "confirm", "needs_pairs", "pair_bases", "pair_names"]
 
 NONE_E = 1.5
 CLOSE_FRACTION = 0.6
@@ -148,3 +149,37 @@ def confirm(effect: str, confidence: str, e_before: float, e_after: float) -> tu
     if effect not in ("none", "unexplained") and e_after >= e_before and e_before > NONE_E:
         return effect, "low", "name_not_confirmed"
     return effect, confidence, None
+
+
+def needs_pairs(scored: Sequence[Scored], floor: float = 0.0) -> bool:
+    """Whether forward selection goes on to pairs: the baseline misses and no single effect brings the
+    held-out score down to `NONE_E`; or the single named is a drift with the run sequence found within
+    the scatter (that scatter is then partly the drift's, and judged without it a second effect may show)."""
+    base = next(s for s in scored if s.name == "baseline")
+    singles = _ranked(scored, False)
+    if not singles:
+        return False
+    if _above_floor(base.score, floor) > NONE_E:
+        return singles[0].score > NONE_E
+    return _within_scatter_drift(base.score, singles, None)
+
+
+def pair_bases(scored: Sequence[Scored]) -> list[str]:
+    """The single effects forward selection extends: the best, and the runner-up when the best does not
+    beat it decisively."""
+    singles = _ranked(scored, False)
+    return [singles[0].name] + ([singles[1].name] if len(singles) > 1 and singles[0].score > MARGIN * singles[1].score
+                                else [])
+
+
+def pair_names(scored: Sequence[Scored], library: Sequence[str]) -> list[str]:
+    """Pairs to try: each base (`pair_bases`) plus each other effect of `library` (a pair is named by the
+    order its effects were added)."""
+    out, seen = [], set()
+    for b in pair_bases(scored):
+        for e in library:
+            key = frozenset((b, e))
+            if e != b and key not in seen:
+                seen.add(key)
+                out.append(f"{b}{JOIN}{e}")
+    return out

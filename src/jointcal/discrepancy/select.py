@@ -17,12 +17,12 @@ runs' noise predicts the unseen level no better), and a further complexity penal
 
 Forward selection. When the best single effect leaves a held-out score above `NONE_E`, or
 is a drift with the run sequence found within the scatter (the drift inflates the repeat
-scatter, so a second effect may hide in it) (`needs_pairs`), the best single (and the
-runner-up, if the best does not beat it decisively, `pair_bases`) is first refit from the
+scatter, so a second effect may hide in it) (`rule.needs_pairs`), the best single (and the
+runner-up, if the best does not beat it decisively, `rule.pair_bases`) is first refit from the
 calibration's other valleys too, with the effort a pair gets (a pair must not win by
 the optimiser's luck alone); if it still leaves the gap, each other effect is added to it:
 the pairs are fitted and scored the same way, on the same folds, with the penalty for all
-their parameters (`pair_names`).
+their parameters (`rule.pair_names`).
 
 The fast model's floor F (its own error against the time simulation of the calibrated model
 on the same runs and bins, `floor.fast_floor`) is taken out of the baseline's score before
@@ -38,11 +38,9 @@ import numpy as np
 
 from .data import RunEnvelope
 from ..io import level_column
-from ..effects import JOIN
 from .fit import Candidate, Fit, envelope_E, fit_candidate, with_transient
-from .rule import MARGIN, NONE_E, _above_floor, _ranked, _within_scatter_drift
 
-__all__ = ["PENALTY_PER_PARAM", "Scored", "score_candidates", "needs_pairs", "pair_bases", "pair_names"]
+__all__ = ["PENALTY_PER_PARAM", "Scored", "score_candidates"]
 
 PENALTY_PER_PARAM = 0.02
 
@@ -146,38 +144,4 @@ def score_candidates(cands: Sequence[Candidate], runs: Sequence[RunEnvelope], th
         out.append(Scored(c.name, full, s, per, time.perf_counter() - t0))
         if log:
             log(f"{c.name}: E on all runs {full.E:.2f}, held-out score {s:.2f} ({time.perf_counter() - t0:.1f} s)")
-    return out
-
-
-def needs_pairs(scored: Sequence[Scored], floor: float = 0.0) -> bool:
-    """Whether forward selection goes on to pairs: the baseline misses and no single effect brings the
-    held-out score down to `NONE_E`; or the single named is a drift with the run sequence found within
-    the scatter (that scatter is then partly the drift's, and judged without it a second effect may show)."""
-    base = next(s for s in scored if s.name == "baseline")
-    singles = _ranked(scored, False)
-    if not singles:
-        return False
-    if _above_floor(base.score, floor) > NONE_E:
-        return singles[0].score > NONE_E
-    return _within_scatter_drift(base.score, singles, None)
-
-
-def pair_bases(scored: Sequence[Scored]) -> list[str]:
-    """The single effects forward selection extends: the best, and the runner-up when the best does not
-    beat it decisively."""
-    singles = _ranked(scored, False)
-    return [singles[0].name] + ([singles[1].name] if len(singles) > 1 and singles[0].score > MARGIN * singles[1].score
-                                else [])
-
-
-def pair_names(scored: Sequence[Scored], library: Sequence[str]) -> list[str]:
-    """Pairs to try: each base (`pair_bases`) plus each other effect of `library` (a pair is named by the
-    order its effects were added)."""
-    out, seen = [], set()
-    for b in pair_bases(scored):
-        for e in library:
-            key = frozenset((b, e))
-            if e != b and key not in seen:
-                seen.add(key)
-                out.append(f"{b}{JOIN}{e}")
     return out

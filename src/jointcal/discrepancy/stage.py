@@ -38,9 +38,9 @@ from .fingerprints import fingerprints, outside_library, residual_map, verdicts
 from .fit import candidate, fit_candidate, model_at, with_transient
 from .floor import fast_floor
 from .recalibrate import recalibrate
-from .rule import CLAUSES, confirm, decide
+from .rule import CLAUSES, confirm, decide, needs_pairs, pair_bases, pair_names
 from .settings import DiscrepancySettings
-from .select import needs_pairs, pair_bases, pair_names, score_candidates
+from .select import score_candidates
 from .words import diagnosis_markdown
 
 __all__ = ["DiscrepancySettings", "diagnose", "diagnosis_markdown", "valley_starts"]
