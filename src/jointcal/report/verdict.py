@@ -29,6 +29,7 @@ import numpy as np
 import pandas as pd
 
 from ..calibrate.space import PARAMS
+from ..effects import EFFECTS
 from ..posterior.noise import scale_words as noise_words
 from ..posterior.stage import P_REJECT
 from ..validate.error import closeness, scale_source, scale_words
@@ -45,6 +46,10 @@ _WORDS = {"K0": "K0 = k + KT", "R": "R (eq. 3.5)", "D_ref": "dissipation per cyc
 def _interval(lo: float, hi: float, unit: str = "") -> str:
     u = "" if unit in ("", "-") else f" {unit}"
     return f"[{_g(lo)}, {_g(hi)}]{u}"
+
+
+def _sentence(s: str) -> str:
+    return s[0].upper() + s[1:] + ("" if s.endswith(".") else ".")
 
 
 def named_effects(diagnosis: Mapping[str, Any]) -> list[str]:
@@ -123,9 +128,13 @@ def _item2(diagnosis: Mapping | None, best: Mapping) -> str:
         rec = diagnosis.get("recalibrated", {})
         pars = "; ".join(f"{html.escape(k)} {_g(v['value'])} {_interval(*v['interval_90'], v.get('unit', ''))}"
                          for k, v in rec.get("effect_parameters", {}).items())
+        vals = {k: v["value"] for k, v in rec.get("effect_parameters", {}).items()}
+        means = " ".join(html.escape(_sentence(EFFECTS[e].advice(vals))) for e in effects
+                         if e in EFFECTS and all(p.name in vals for p in EFFECTS[e].params))
         return (f"It names <b>{html.escape(' + '.join(effects))}</b> (confidence {html.escape(str(diagnosis.get('confidence')))})"
                 + (f": {pars}" if pars else "") + f". With it E goes from <b>{E0:.2f}</b> to <b>{E1:.2f}</b> "
-                f"({closeness(E1)}), checked with the time simulation driven by each run's measured reference record.")
+                f"({closeness(E1)}), checked with the time simulation driven by each run's measured reference record."
+                + (f" What it means: {means}" if means else ""))
     if diagnosis.get("effect") == "none":
         return f"No missing effect: the paper's model predicts the levels it did not see within the scatter (E = {E0:.2f})."
     return (f"Unexplained: no library effect closes the gap decisively (E = {E0:.2f}); "
