@@ -27,7 +27,9 @@ from ..validate.drive import equivalent_base
 from ..validate.error import BINS
 from ..validate.runs import full_drive_fraction
 
-__all__ = ["RunEnvelope", "run_envelope", "run_zeta", "scale_arrays"]
+__all__ = ["RunEnvelope", "run_envelope", "run_zeta", "scale_arrays", "MIN_FRAMES"]
+
+MIN_FRAMES = 5  # frames in the band a run needs (a fast chirp's long windows leave 7-10 around its mode)
 
 
 @dataclass(frozen=True)
@@ -70,9 +72,14 @@ class RunEnvelope:
 
 
 def run_zeta(row: Mapping) -> float:
-    """A run's measured damping ratio: at phase resonance, else from the half-power width (NaN if neither)."""
-    zeta = float(row.get("zeta_phase_resonance", np.nan))
-    return zeta if np.isfinite(zeta) else float(row.get("zeta_half_power", np.nan))
+    """A run's measured damping ratio: the read-out's (``zeta_res``, the modal stage's rule: at phase resonance
+    for a base drive, the sweep fit's for a fast chirp), else at phase resonance, else from the half-power
+    width (NaN if none)."""
+    for key in ("zeta_res", "zeta_phase_resonance", "zeta_half_power"):
+        zeta = float(row.get(key, np.nan))
+        if np.isfinite(zeta):
+            return zeta
+    return float("nan")
 
 
 def scale_arrays(scale: Sequence[Mapping] | pd.DataFrame | None, floor_db: float = 0.05,
@@ -107,7 +114,7 @@ def run_envelope(env: pd.DataFrame, row: Mapping, sigma_db: NDArray, sigma_deg: 
     env : DataFrame
         The run's envelopes (`jointcal.measure.envelopes.envelopes`).
     row : mapping
-        Its modal row (f_res_hz, zeta_phase_resonance, flags) merged with the manifest row.
+        Its modal row (f_res_hz, zeta_res, flags) merged with the manifest row.
     sigma_db, sigma_deg : ndarray, shape (len(BINS) - 1,)
         Repeat scatter per bin of |x| = |f/f_res - 1| / zeta.
     band : (lo, hi)
@@ -130,7 +137,7 @@ def run_envelope(env: pd.DataFrame, row: Mapping, sigma_db: NDArray, sigma_deg: 
     ok = full_drive(env, full_drive_fraction(row))
     ok &= (f >= band[0] * f_res) & (f <= band[1] * f_res)
     idx = np.flatnonzero(ok)
-    if idx.size < 8:
+    if idx.size < MIN_FRAMES:
         return None
     idx = idx[np.unique(np.linspace(0, idx.size - 1, min(max_frames, idx.size)).round().astype(int))]
     t = env["time_s"].to_numpy(float)

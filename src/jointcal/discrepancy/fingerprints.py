@@ -74,7 +74,7 @@ def fingerprints(res: pd.DataFrame, modal: pd.DataFrame, model_fz: Mapping[str, 
         `residual_map` of the baseline.
     modal : DataFrame
         The assembly's usable modal rows (run_id, its level column, sequence, f_res_hz,
-        zeta_phase_resonance, h2_ratio, h3_ratio).
+        zeta_res or zeta_phase_resonance, h2_ratio, h3_ratio).
     model_fz : mapping run_id -> (f_hz, zeta)
         The baseline's harmonic-balance frequency and damping at each run's measured amplitude.
     joint : mapping
@@ -96,7 +96,8 @@ def fingerprints(res: pd.DataFrame, modal: pd.DataFrame, model_fz: Mapping[str, 
     col = level_column(mo.columns)
     lev = np.log10(mo[col].astype(float))
     out["f_trend_per_decade"] = _slope(lev, mo["f_res_hz"] / mo["f_mod"] - 1)
-    out["zeta_trend_per_decade"] = _slope(lev, mo["zeta_phase_resonance"] / mo["z_mod"] - 1)
+    zc = "zeta_res" if "zeta_res" in mo else "zeta_phase_resonance"  # the read-out's damping (`data.run_zeta`)
+    out["zeta_trend_per_decade"] = _slope(lev, mo[zc] / mo["z_mod"] - 1)
     counts = mo.groupby(col).size()
     lv = counts.idxmax() if len(counts) else np.nan
     rep = mo[mo[col] == lv].sort_values("sequence")
@@ -111,7 +112,7 @@ def fingerprints(res: pd.DataFrame, modal: pd.DataFrame, model_fz: Mapping[str, 
     bot = mo[mo[col] == mo[col].min()]
     chi = float(joint["chi"])
     f0 = np.sqrt((joint["k"] + joint["KT"]) / m) / (2 * np.pi)
-    ratio = (bot["zeta_phase_resonance"] - joint["zeta_v"]) / (1 - bot["f_res_hz"] / f0)
+    ratio = (bot[zc] - joint["zeta_v"]) / (1 - bot["f_res_hz"] / f0)
     out["masing_ratio"] = float(ratio.median() / (4 * (chi + 1) / (np.pi * (chi + 3)))) if len(bot) else np.nan
     return {k: (float(v) if np.isfinite(v) else None) for k, v in out.items()}
 
