@@ -26,6 +26,7 @@ from dataclasses import dataclass, replace
 from functools import cached_property
 
 import numpy as np
+import pandas as pd
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
@@ -35,7 +36,7 @@ from ..models.swept import quasi_steady_runs
 from .data import RunEnvelope, run_zeta
 from ..effects import EFFECTS, apply_effect, effects_of
 
-__all__ = ["HELD", "Candidate", "Fit", "candidate", "model_at", "fit_candidate", "envelope_E", "observed", "predict",
+__all__ = ["HELD", "Candidate", "Fit", "candidate", "structure_scales", "model_at", "fit_candidate", "envelope_E", "observed", "predict",
            "with_transient"]
 
 HELD = ("beta",)  # joint parameters the envelopes barely constrain: held at the start's value by every fit
@@ -49,6 +50,7 @@ class Candidate:
     name: str
     space: ParamSpace
     m: float
+    scales: tuple[tuple[str, float], ...] | None = None  # (K0, f0, q) of a structure other than the Ministack
 
     @property
     def effects(self) -> tuple[str, ...]:
@@ -56,7 +58,9 @@ class Candidate:
 
     @property
     def effect_params(self):
-        return tuple(p for e in self.effects for p in EFFECTS[e].params)
+        """The effects' parameters, their ranges set for the structure when `scales` are given
+        (`jointcal.effects.Effect.rescale`; the library's ranges are the Ministack's)."""
+        return tuple(p for e in self.effects for p in EFFECTS[e].params_for(dict(self.scales or ())))
 
     @property
     def sequence_dependent(self) -> bool:
@@ -81,10 +85,19 @@ class Candidate:
         return self.grown.to_unit(theta)
 
 
-def candidate(name: str, space: ParamSpace, m: float) -> Candidate:
-    """The candidate of a model name ('baseline', an effect, or effects joined by '+')."""
+def candidate(name: str, space: ParamSpace, m: float, scales: Mapping[str, float] | None = None) -> Candidate:
+    """The candidate of a model name ('baseline', an effect, or effects joined by '+'); `scales`
+    (`structure_scales`) set its effects' ranges for a structure other than the Ministack."""
     effects_of(name)  # one sentence for an unknown name
-    return Candidate(name, space, m)
+    return Candidate(name, space, m, None if scales is None else tuple(sorted(scales.items())))
+
+
+def structure_scales(best: Mapping, modal: pd.DataFrame) -> dict[str, float]:
+    """The structure's scales the effects' ranges follow: its stuck stiffness K0 = k + KT (lbf/in), stuck
+    frequency f0 (Hz) and largest amplitude measured q (in), from the calibration and the read-outs."""
+    K0 = float(best["k"]) + float(best["KT"])
+    return {"K0": K0, "f0": float(np.sqrt(K0 / float(best["m"])) / (2 * np.pi)),
+            "q": float(pd.to_numeric(modal["q_in"], errors="coerce").max())}
 
 
 def model_at(c: Candidate, theta: NDArray, row: Mapping) -> MinistackModel:

@@ -35,7 +35,7 @@ from ..validate.drive import drive_gain
 from ..validate import ValidateSettings, model_from_best, validate_runs
 from .data import run_envelope, scale_arrays
 from .fingerprints import fingerprints, outside_library, residual_map, verdicts
-from .fit import candidate, fit_candidate, model_at, with_transient
+from .fit import candidate, fit_candidate, model_at, structure_scales, with_transient
 from .floor import fast_floor
 from .recalibrate import recalibrate
 from .rule import CLAUSES, confirm, decide, needs_pairs, pair_bases, pair_names
@@ -76,8 +76,8 @@ def _with_joint(c, theta, joint) -> np.ndarray:
     return c.grown.vector(dict(zip(PARAMS, map(float, joint))), default=c.grown.named(theta))
 
 
-def _candidate_json(s, space, m, ver) -> dict:
-    c = candidate(s.name, space, m)
+def _candidate_json(s, space, m, ver, scales) -> dict:
+    c = candidate(s.name, space, m, scales)
     values = c.grown.named(s.fit.theta)
     eff = {p.name: {"value": values[p.name], "unit": p.unit, "interval_90": _interval(s.fit, c, p.name)}
            for p in c.effect_params}
@@ -115,6 +115,7 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     m = float(best["m"])
     kind = str(best.get("model_kind", "ministack"))
     settings = replace(settings, candidates=tuple(n for n in settings.candidates if kind in EFFECTS[n].kinds))
+    scales = structure_scales(best, modal[modal["assembly"] == assembly]) if kind != "ministack" else None
     gain = drive_gain(modal[modal["assembly"] == assembly]) if level_column(modal.columns) != LEVEL["base"] else None
     if gain is not None:  # a force or voltage drives the mode through the campaign's modal constant
         rows = [{**r, "drive_gain": gain} for r in rows]
@@ -130,20 +131,20 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     mrows = modal[modal["assembly"] == assembly].set_index("run_id")
     runs = _usable_runs(assembly, envs, mrows, rows, sdb, sdeg, settings, float((envelopes_kw or {}).get("zeta_min", 0.01)))
     say(f"{assembly}: {len(runs)} usable runs, {sum(r.f_hz.size for r in runs)} envelope frames")
-    c0 = candidate("baseline", space, m)
+    c0 = candidate("baseline", space, m, scales)
     floor = fast_floor(c0, theta0, runs, frames_before, sdb, sdeg)
     F = floor["E"] if floor["E"] is not None else 0.0
     say(f"{assembly}: the fast model's floor (its envelope of the calibrated model against the time simulation) "
         f"E = {F:.2f}" + ("" if floor["E"] is not None else " (no validation frames to compare: taken as 0)"))
     clock.lap("floor")
-    scored, pairs_tried = _score_library(assembly, space, m, runs, theta0, F, settings, joint_starts, clock, say)
+    scored, pairs_tried = _score_library(assembly, space, m, runs, theta0, F, settings, joint_starts, clock, say, scales)
     base = next(s for s in scored if s.name == "baseline")
     res, fp, ver, outside = _localise(c0, base, runs, mrows, m, sdb)
     decision = decide(scored, outside, floor=F)
     effect, confidence, ranked = decision.effect, decision.confidence, decision.ranked
     named = next((s for s in ranked if s.name == effect), None)
     final, cf, rec, n_fits = _recalibrated(assembly, named if named is not None else base, space, m, runs,
-                                           joint_starts, settings, say)
+                                           joint_starts, settings, say, scales)
     clock.lap("recalibrate")
     say(f"{assembly}: decision {effect} ({confidence}); revalidating with the time simulation")
     v_after = validate_runs([model_at(cf, final.fit.theta, r) for r in rows], records, rows, **vkw)
@@ -153,7 +154,7 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     clock.lap("validate_after")
     effect, confidence, time_note = confirm(effect, confidence, float(metric_before), metric_after)
     diagnosis = {
-        "assembly": assembly, "model_kind": kind, "level_unit": (level_column(modal.columns) or "_").split("_", 1)[1],
+        "assembly": assembly, "model_kind": kind, "structure_scales": scales, "level_unit": (level_column(modal.columns) or "_").split("_", 1)[1],
         "effect": effect, "effects": list(effects_of(effect)) if effect not in (
             "none", "unexplained") else [], "confidence": confidence, "rule": decision.rule,
         "rule_applied": [*decision.applied, *([CLAUSES[time_note]] if time_note else [])],
@@ -161,7 +162,7 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
         "fast_model_floor": floor, "time_domain_check": time_note,
         "baseline": {"held_out_score": base.score, "E_fit": base.fit.E, "held_out_E_per_level": base.held_out,
                      "joint_parameters": c0.grown.named(base.fit.theta, PARAMS)},
-        "candidates": [_candidate_json(s, space, m, ver) for s in ranked], "pairs_tried": pairs_tried,
+        "candidates": [_candidate_json(s, space, m, ver, scales) for s in ranked], "pairs_tried": pairs_tried,
         "fingerprints": fp, "metric_before": float(metric_before), "metric_after": metric_after,
         "metric_change": metric_after / metric_before - 1.0 if metric_before else None,
         "recalibrated": _recalibrated_json(final, cf, rec, n_fits),
@@ -201,12 +202,12 @@ def _usable_runs(assembly, envs, mrows, rows, sdb, sdeg, settings, zeta_min) -> 
     return runs
 
 
-def _score_library(assembly, space, m, runs, theta0, F, settings, joint_starts, clock, say):
+def _score_library(assembly, space, m, runs, theta0, F, settings, joint_starts, clock, say, scales):
     """Every candidate refit and scored on held-out folds; pairs by forward selection when no single
     effect closes the gap (the bases refit from the calibration's other valleys first).
 
     Returns the scored candidates and the pairs tried."""
-    cands = [candidate("baseline", space, m)] + [candidate(n, space, m) for n in settings.candidates]
+    cands = [candidate("baseline", space, m, scales)] + [candidate(n, space, m, scales) for n in settings.candidates]
     scored = score_candidates(cands, runs, theta0, max_nfev=settings.max_nfev, log=say)
     base = next(s for s in scored if s.name == "baseline")
     clock.lap("singles")
@@ -214,9 +215,9 @@ def _score_library(assembly, space, m, runs, theta0, F, settings, joint_starts, 
     if needs_pairs(scored, F):
         bases = pair_bases(scored)
         fits = {s.name: s.fit.theta for s in scored}
-        refined = score_candidates([candidate(b, space, m) for b in bases], runs, theta0, baseline=base, log=say,
+        refined = score_candidates([candidate(b, space, m, scales) for b in bases], runs, theta0, baseline=base, log=say,
                                    max_nfev=2 * settings.max_nfev,
-                                   starts={b: [fits[b]] + [_with_joint(candidate(b, space, m), fits[b], th)
+                                   starts={b: [fits[b]] + [_with_joint(candidate(b, space, m, scales), fits[b], th)
                                                            for th in joint_starts] for b in bases})
         better = {r.name: r for r in refined if r.fit.E < next(s for s in scored if s.name == r.name).fit.E}
         scored = [better.get(s.name, s) for s in scored]
@@ -224,7 +225,7 @@ def _score_library(assembly, space, m, runs, theta0, F, settings, joint_starts, 
         names = pair_names(scored, settings.candidates)
         say(f"{assembly}: no single effect closes the gap; forward selection tries {len(names)} pairs")
         fits = {s.name: s.fit.theta for s in scored}
-        pc = [candidate(n, space, m) for n in names]
+        pc = [candidate(n, space, m, scales) for n in names]
         scored += score_candidates(pc, runs, theta0, max_nfev=2 * settings.max_nfev, log=say, baseline=base,
                                    starts={n: [fits[effects_of(n)[0]]] for n in names})
         pairs_tried = names
@@ -247,11 +248,11 @@ def _localise(c0, base, runs, mrows, m, sdb):
     return res, fp, ver, outside_library(fp)
 
 
-def _recalibrated(assembly, final, space, m, runs, joint_starts, settings, say):
+def _recalibrated(assembly, final, space, m, runs, joint_starts, settings, say, scales):
     """The named (or baseline) model refit from the calibration's other valleys too, then recalibrated
     (`recalibrate`: GA over the grown space, polish, emcee). Returns the scored candidate with the
     recalibrated fit, the candidate, the recalibration and the number of seeding fits."""
-    cf = candidate(final.name, space, m)
+    cf = candidate(final.name, space, m, scales)
     fits = [final.fit]
     for th in joint_starts:
         start = _with_joint(cf, final.fit.theta, th)

@@ -74,7 +74,7 @@ def _named(d: Mapping, E0: float, E1: float) -> list[str]:
     if d.get("outside_library"):
         lines += ["But something else is there too: " + d["outside_library"] + ".", ""]
     lines += [_floor(d), ""]
-    bounds = {p.name: (p.lo, p.hi) for e in effects for p in EFFECTS[e].params}
+    bounds = {p.name: (p.lo, p.hi) for e in effects for p in EFFECTS[e].params_for(d.get("structure_scales"))}
     for k, v in d["recalibrated"]["effect_parameters"].items():
         lo, hi = v["interval_90"]
         loose = lo <= bounds[k][0] * (1 + 1e-6) or hi >= bounds[k][1] * (1 - 1e-6)

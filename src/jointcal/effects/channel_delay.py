@@ -22,7 +22,13 @@ def _advice(v):
             "and signal conditioners of the two channels (same type and setting), or correct the phase by 2 pi f tau")
 
 
+def _rescale(sc):
+    """0 to a fifth of the stuck period, 72 deg at f0 (the Ministack's 0-500 us is about a fifth at 400 Hz)."""
+    return {"tau_s": (0.0, 0.2 / sc["f0"], 0.01 / sc["f0"])}
+
+
 EFFECT = Effect(
     "channel_delay", (EffectParam("tau_s", "s", 0.0, 5e-4, False, 2e-5, "response channel delay relative to the reference"),),
     _apply, _advice, _fingerprint, hidden={"tau_s": 40e-6},
-    summary="response channel delayed by tau_s relative to the reference channel (exact fractional delay)")
+    summary="response channel delayed by tau_s relative to the reference channel (exact fractional delay)",
+    rescale=_rescale)

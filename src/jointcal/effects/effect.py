@@ -18,6 +18,9 @@ An effect is physics a calibrated joint model may be missing. `Effect` holds:
 * ``hidden``: the strength at which the virtual lab (`jointcal.synth`) hides it by default;
 * ``library``: whether the discrepancy workflow tries it (an effect kept out on purpose tests
   the workflow's 'unexplained');
+* ``rescale``: the ranges of its parameters for another structure than the Ministack, from its
+  stuck stiffness K0, frequency f0 and largest amplitude q (a cubic spring's range follows
+  K0 / q^2, a delay's the period);
 * ``kinds``: the model kinds (`jointcal.calibrate.kind`) whose discrepancy library holds it:
   ``ministack`` (the base-driven rig) and ``modal`` (one mode of any structure, force- or
   voltage-driven). An effect that applies to both lives once.
@@ -25,7 +28,7 @@ An effect is physics a calibrated joint model may be missing. `Effect` holds:
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ..models import MinistackModel
 
@@ -67,6 +70,8 @@ class Effect:
     library: bool = True
     summary: str = ""  # what it is, in a line
     kinds: tuple[str, ...] = ("ministack", "modal")
+    # ranges of its parameters for another structure: scales {K0 lbf/in, f0 Hz, q in} -> {name: (lo, hi, start)}
+    rescale: Callable[[Mapping[str, float]], Mapping[str, tuple[float, float, float]]] | None = None
 
     def __post_init__(self) -> None:
         names = [p.name for p in self.params]
@@ -75,6 +80,15 @@ class Effect:
         if self.hidden is not None and set(self.hidden) != set(names):
             raise ValueError(f"effect {self.name}: hidden defaults {sorted(self.hidden)} must name exactly its "
                              f"parameters {sorted(names)}.")
+
+    def params_for(self, scales: Mapping[str, float] | None = None) -> tuple[EffectParam, ...]:
+        """Its parameters, their ranges and starts set by `rescale` for a structure of the given scales
+        (none given, or no `rescale`: the library's own, the Ministack's)."""
+        if not scales or self.rescale is None:
+            return self.params
+        new = self.rescale(scales)
+        return tuple(replace(p, lo=new[p.name][0], hi=new[p.name][1], start=new[p.name][2]) if p.name in new else p
+                     for p in self.params)
 
     @property
     def defaults(self) -> dict[str, float]:
