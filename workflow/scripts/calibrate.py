@@ -21,7 +21,8 @@ def main(smk) -> None:
     try:
         settings = CalibrateSettings.from_config(smk.params.calibrate)
         _, notes = run_calibration(smk.input.modal, smk.wildcards.assembly, Path(smk.output.best).parent, settings,
-                                   checkpoint=smk.params.checkpoint, progress=progress)
+                                   checkpoint=smk.params.checkpoint, progress=progress,
+                                   backbone_csv=smk.input.backbone)
     except (CalibrationInputError, ValueError) as exc:
         progress(str(exc))
         sys.exit(f"jointcal: {exc}")

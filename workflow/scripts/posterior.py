@@ -21,13 +21,13 @@ from jointcal.posterior.identified import identified_table, unsettled
 def write_identified(smk, cal: CalibrateSettings, post: PosteriorSettings) -> str:
     """identified.csv from the chain just written; returns a line for the log."""
     cal = cal.resolved(json.loads(Path(smk.input.best).read_text()))
-    data = read_modal(smk.input.modal, smk.wildcards.assembly, damping=cal.damping)
+    data = read_modal(smk.input.modal, smk.wildcards.assembly, damping=cal.damping, backbone_csv=smk.input.backbone)
     with np.load(smk.output.chain) as z:
         names = [str(n) for n in z["sample_names"]]
         why_not = unsettled({k: z[k] for k in z.files}, names, tau_factor=post.tau_factor)
         table, _ = identified_table(z["samples"], names, cal.space, data.q, data.f, data.zeta, m=cal.m,
                                     model=cal.model, viscous=cal.viscous, ratio=post.constrained_ratio,
-                                    why_not=why_not)
+                                    why_not=why_not, weight=data.weight)
     write_csv_atomic(table, smk.output.identified)
     return ("identified: " + ", ".join(table.loc[table["identified"], "quantity"]) + "; left to the bounds: "
             + ", ".join(table.loc[~table["identified"], "quantity"]) + (f" ({why_not})" if why_not else ""))
@@ -45,7 +45,7 @@ def main(smk) -> None:
         post = PosteriorSettings.from_config(smk.params.posterior)
         res, notes = run_posterior(smk.input.modal, smk.input.scatter, smk.input.best, smk.wildcards.assembly,
                                    Path(smk.output.summary).parent, cal, post, checkpoint=smk.params.checkpoint,
-                                   progress=progress)
+                                   progress=progress, backbone_csv=smk.input.backbone)
         notes.append(write_identified(smk, cal, post))
     except (CalibrationInputError, ValueError) as exc:
         progress(str(exc))

@@ -112,7 +112,8 @@ def quantities(q: ArrayLike, *, m: float, model: str = "harmonic_balance", visco
 
 def identified_table(samples: ArrayLike, names: Sequence[str], space: ParamSpace, q: ArrayLike, f: ArrayLike,
                      zeta: ArrayLike, *, m: float, model: str = "harmonic_balance", viscous: str = "dashpot",
-                     ratio: float = 0.5, why_not: str = "") -> tuple[pd.DataFrame, NDArray[np.float64]]:
+                     ratio: float = 0.5, why_not: str = "",
+                     weight: ArrayLike | None = None) -> tuple[pd.DataFrame, NDArray[np.float64]]:
     """Every candidate quantity with its 90% interval and whether the data identify it.
 
     Parameters
@@ -138,6 +139,8 @@ def identified_table(samples: ArrayLike, names: Sequence[str], space: ParamSpace
         reports none of them identified (the curves at the measured amplitudes, fixed by the
         read-outs themselves, still are). ``identified`` stays the local information's
         judgement, which the design stage reads to choose what the next test must fix.
+    weight : array_like, shape (N,), optional
+        The read-outs' weights in the likelihood (`jointcal.calibrate.ModalData.weight`); default 1.
 
     Returns
     -------
@@ -152,7 +155,7 @@ def identified_table(samples: ArrayLike, names: Sequence[str], space: ParamSpace
     S = np.asarray(samples, dtype=float)
     theta = S[:, [col[p] for p in space.names]]
     sigma = S[:, [col["sigma_f"], col["sigma_zeta"]]]
-    info = fisher(theta, sigma, q, f, zeta, space, m=m, model=model, viscous=viscous)
+    info = fisher(theta, sigma, q, f, zeta, space, m=m, model=model, viscous=viscous, weight=weight)
     n_fixed = float(np.median(fixed_directions(info, ratio)))
     u = space.to_unit(theta)
     cov = np.cov(u, rowvar=False)
