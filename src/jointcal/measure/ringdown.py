@@ -17,7 +17,13 @@ The estimator (``ringdown_backbone``), in the order data flows:
    (on the virtual Ministack +-8% in zeta over its first 7 periods), so the decay is filtered apart,
    preceded by `EXTEND` periods of its own continuation backwards: the damped sinusoid fitted to its
    first window, raw and then once more band-passed. The first `SETTLE` period is left out (the
-   drive's last sample above `DRIVE_OFF` lies within the DAQ filter's ring after the cut).
+   drive's last sample above `DRIVE_OFF` lies within the DAQ filter's ring after the cut). Where the
+   raw first window is not one damped sinusoid (its misfit above `MISFIT_MAX`: other modes ring from
+   the start, as after an impact), one mode's continuation would start the others abruptly at the
+   junction (a 41 Hz mode 1.5x an 18.6 Hz one: zeta 11% off in its first window), so the whole record
+   is band-passed, the first `SETTLE_MIXED` periods left out and the windows start twice as long (an
+   18.6 Hz mode with modes at 7 and 41 Hz, 0.5x and 1.5x, from the impact, 18 onset phases: zeta
+   within 6.8% from 3 periods, 2.9% from 4, 1.9% from 5; 6-period windows from 3 periods had 7.7%).
 3. **Damped sinusoid fits in sliding windows** (`jointcal.measure._decay_window.fit_window`): decay
    rate and frequency at the window's centre, each drifting linearly over it, by variable projection.
    A window is `MIN_CYCLES` periods long while the noise allows; where its decay rate's standard
@@ -62,7 +68,7 @@ from ..units import G
 from ._decay_window import fit_window
 
 __all__ = ["decay_start", "ringdown_backbone", "DRIVE_OFF", "HOLD", "BAND", "ZETA_SE_MAX", "MISFIT_MAX", "SETTLE",
-           "TAIL", "MIN_CYCLES", "GROW", "SPAN_MAX", "EXTEND"]
+           "TAIL", "MIN_CYCLES", "GROW", "SPAN_MAX", "EXTEND", "SETTLE_MIXED"]
 
 DRIVE_OFF = 0.02  # a drive below this share of its largest value is off
 HOLD = 0.05  # without a drive: the decay starts where the envelope last lies within this share of its plateau
@@ -71,6 +77,7 @@ ZETA_SE_MAX = 0.01  # a window is read while its decay rate's standard error is 
 TAIL = 0.1  # share of the record at its end whose band-passed rms is the noise (the decay has died out)
 MISFIT_MAX = 0.05  # relative rms residual of a window fit above which it is not one decaying mode
 SETTLE = 1.0  # periods after the decay's start before the first window: the DAQ filter's ring at the cut-off
+SETTLE_MIXED = 5.0  # the same where other modes ring from the start: their onsets' ring through the band-pass
 MIN_CYCLES = 3.0  # the shortest window, periods of the mode
 GROW = 1.25  # a window too short for the noise grows by this factor
 SPAN_MAX = 2.0  # a window covers at most this many e-folds of the decay (sigma * length): amplitude / 7.4
@@ -122,15 +129,19 @@ def _centred(n: int, fs: float) -> NDArray:
     return (np.arange(n) - (n - 1) / 2) / fs
 
 
-def _band_passed_decay(x: NDArray, y: NDArray, i0: int, sos, n: int, fs: float, f_hz: float) -> NDArray:
+def _band_passed_decay(x: NDArray, y: NDArray, i0: int, sos, n: int, fs: float, f_hz: float) -> NDArray | None:
     """`y` (the whole record band-passed) with its decay from `i0` on band-passed apart, after `EXTEND`
     periods of its own damped sinusoid continued backwards (fitted to its first `n` samples: raw, then once
-    band-passed), so that the filter sees no forced response and no edge at the decay's start."""
+    band-passed), so that the filter sees no forced response and no edge at the decay's start; None where the
+    raw decay's first window is not one damped sinusoid (its misfit above `MISFIT_MAX`: other modes ring from
+    the start, and a continuation of this mode alone would start them abruptly at the junction)."""
     pad = int(round(EXTEND * fs / f_hz))
     t_pad = (np.arange(-pad, 0) - (n - 1) / 2) / fs
     src = x
-    for _ in range(2):
-        w, sig, c, _, _ = fit_window(_centred(n, fs), src[i0:i0 + n], 2 * np.pi * f_hz)
+    for k in range(2):
+        w, sig, c, misfit, _ = fit_window(_centred(n, fs), src[i0:i0 + n], 2 * np.pi * f_hz)
+        if k == 0 and misfit > MISFIT_MAX:
+            return None
         cont = np.exp(-sig * t_pad) * (c.real * np.cos(w * t_pad) + c.imag * np.sin(w * t_pad))
         src = np.concatenate([y[:i0], signal.sosfiltfilt(sos, np.concatenate([cont, x[i0:]]))[pad:]])
     return src
@@ -172,11 +183,15 @@ def ringdown_backbone(response_g: NDArray, fs: float, f_hz: float, *, start: int
     i0 = decay_start(fs, y, drive) if start is None else int(start)
     n = max(16, int(round(min_cycles * fs / f_hz)))
     noise = float(np.sqrt(np.mean(y[-max(n, int(TAIL * y.size)):] ** 2)))  # where the decay has died out
-    if i0 + n <= y.size:
-        y = _band_passed_decay(x, y, i0, sos, n, fs, f_hz)
+    apart = _band_passed_decay(x, y, i0, sos, n, fs, f_hz) if i0 + n <= y.size else None
+    settle = SETTLE
+    if apart is None:  # other modes from the start: the whole record band-passed, read after their onsets' ring
+        settle, n = SETTLE_MIXED, 2 * n
+    else:
+        y = apart
     per_sample = np.sqrt(fs / (4 * BAND * f_hz))  # one independent noise sample in fs / 2B
     w0, sig0, rows = 2 * np.pi * f_hz, 0.0, []
-    lo = i0 + int(round(SETTLE * fs / f_hz))
+    lo = i0 + int(round(settle * fs / f_hz))
     while lo + n <= y.size:
         w, sig, c, res, se_sig = fit_window(_centred(n, fs), y[lo:lo + n], w0, sig0)
         n_eff = n / per_sample**2
