@@ -72,12 +72,17 @@ def scatter_table(modal: pd.DataFrame) -> pd.DataFrame:
 
 
 def write_tables(folder, truths, **kw):
-    """Write modal_properties.csv and scatter.csv into `folder`/modal; return their paths."""
+    """Write modal_properties.csv, scatter.csv and backbone.csv (each run's one point, as the modal stage writes
+    for sweeps) into `folder`/modal; return the first two's paths."""
     from pathlib import Path
+
+    from jointcal.measure.modes import with_modes
+    from jointcal.measure.testkinds import backbone_table
 
     modal, scatter = modal_tables(truths, **kw)
     d = Path(folder) / "modal"
     d.mkdir(parents=True, exist_ok=True)
     modal.to_csv(d / "modal_properties.csv", index=False)
     scatter.to_csv(d / "scatter.csv", index=False)
+    backbone_table(with_modes(modal), []).to_csv(d / "backbone.csv", index=False)
     return d / "modal_properties.csv", d / "scatter.csv"

@@ -23,11 +23,33 @@ def test_a_linear_decay_gives_its_frequency_and_damping():
     assert len(bb) > 10 and bb["q_in"].is_monotonic_decreasing
     # the issue's line (0.1%, 3%) down to where the noise floor stops the read-out
     assert np.abs(bb["f_hz"] / f0 - 1).max() < 1e-3 and np.abs(bb["zeta"] / z0 - 1).max() < 0.03
-    assert np.log10(bb["q_in"].max() / bb["q_in"].min()) > 1.5  # 1.5 decades read from 5800x over the noise
-    # the amplitude: |x| = exp(-zeta wn (t - t_cut)) g at the window's centre, over wn^2 in inches
+    # 5800x over the noise: three decades (6-period windows had read two, growing windows read on)
+    assert np.log10(bb["q_in"].max() / bb["q_in"].min()) > 2.5
+    # the amplitude: |x| = exp(-zeta wn (t - t_cut)) g at the window's centre, over wn^2 in inches; within 2e-3
+    # over the top two decades, within 5e-3 below them, where the window's amplitude carries the noise's 0.1-0.5%
     q_true = np.exp(-z0 * wn * (bb["t_s"] - t_cut)) * G / wn**2
-    assert np.abs(bb["q_in"] / q_true - 1).max() < 2e-3
+    err = np.abs(bb["q_in"] / q_true - 1)
+    top = bb["q_in"] >= bb["q_in"].max() / 100
+    assert err[top].max() < 2e-3 and err.max() < 5e-3
     assert bb["flags"].iloc[-1] == "noise_floor"  # it stopped at the noise, and says so
+
+
+def test_other_modes_ringing_from_the_start_leave_the_mode_read_from_the_whole_record():
+    """After an impact every mode rings from the cut: a continuation of one mode alone would start the others
+    abruptly at the junction (zeta 11% off in the first window), so the record is band-passed whole and read
+    after their onsets' ring (measured over 18 onset phases: f within 1.1e-4, zeta within 1.9%, 2.8 decades)."""
+    fs, t_cut = 1024.0, 2.0
+    t = np.arange(int(30 * fs)) / fs
+
+    def free(f0, z0, a):
+        wn = 2 * np.pi * f0
+        return a * np.where(t < t_cut, 0.0, np.exp(-z0 * wn * (t - t_cut)) * np.sin(wn * np.sqrt(1 - z0**2) * (t - t_cut)))
+
+    x = free(18.6, 0.005, 1.0) + free(41.0, 0.004, 1.5) + free(7.0, 0.01, 0.5)
+    x += 1e-4 * np.random.default_rng(2).standard_normal(t.size)
+    bb = ringdown_backbone(x, fs, 18.0, start=int(t_cut * fs))
+    assert np.abs(bb["f_hz"] / 18.6 - 1).max() < 1e-3 and np.abs(bb["zeta"] / 0.005 - 1).max() < 0.03
+    assert np.log10(bb["q_in"].max() / bb["q_in"].min()) > 2.5
 
 
 @pytest.fixture(scope="module")

@@ -53,12 +53,11 @@ def test_virtual_dwells_read_the_harmonic_balance_at_the_amplitude_reached(lab):
     assert len(pts) == 5 and np.abs(pts["f_hz"] / f_p - 1).max() < 5e-4  # the base's modal constant is -G exactly
 
 
-@pytest.mark.xfail(strict=True, reason="issue 31's ring-down line (0.1% / 3% over 1.5 decades) is not met on the "
-                   "virtual Ministack at 0.1% noise: each run reads 0.69-0.80 decades (9-11 windows, 2274-2381 "
-                   "Hz), f within 0.11%, zeta within 2.8% (the joint stiffens 5% over them)")
 def test_virtual_ring_downs_read_the_harmonic_balance_backbone(lab):
+    # issue 31's line on every window of the six decays (the ring-down and the five dwells' own), each read over
+    # 1.5 decades or more (here 1.66-1.96; over six seeds 1.66-2.12 decades, f within 0.062%, zeta within 2.9%)
     _, _, bb = lab
     rd = bb[bb["test"] == "ringdown"]
     f, z = harmonic_balance(rd["q_in"].to_numpy(), *JOINT)
     assert np.abs(rd["f_hz"] / f - 1).max() < 1e-3 and np.abs(rd["zeta"] / z - 1).max() < 0.03
-    assert max(np.log10(g["q_in"].max() / g["q_in"].min()) for _, g in rd.groupby("run_id")) > 1.5
+    assert min(np.log10(g["q_in"].max() / g["q_in"].min()) for _, g in rd.groupby("run_id")) > 1.5

@@ -60,6 +60,9 @@ def test_a_sweep_row_gives_its_one_point():
     bb = backbone_table(modal, [])
     assert bb.to_dict("records") == [{"run_id": "s1", "mode": "m20", "test": "sweep", "q_in": 1e-3, "f_hz": 20.0,
                                       "zeta": 0.02}]
+    # no usable run at all (ring-downs recorded too short to read: no read-out columns): an empty table
+    none = pd.DataFrame({"run_id": ["r1"], "mode": ["m20"], "flags": ["no_decay;unusable"]})
+    assert list(backbone_table(none, []).columns) == BACKBONE_COLUMNS and backbone_table(none, []).empty
 
 
 def test_dwells_and_ring_downs_are_no_repeats_in_the_scatter(modal):

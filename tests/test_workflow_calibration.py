@@ -6,16 +6,20 @@ without the upstream stages.
 """
 from __future__ import annotations
 
+import json
 import shutil
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 import yaml
 from _campaign import REPO, unit
-from _modal_tables import TABLE_3_2, write_tables
+from _modal_tables import M, TABLE_3_2, write_tables
+
+from jointcal.models import harmonic_balance
 
 pytestmark = pytest.mark.slow
 
@@ -104,6 +108,35 @@ def test_calibrate_then_posterior_then_nothing_to_do_until_the_config_changes(wo
     assert summary.index("The validation stage did not run") < summary.index("What do the data identify")
     assert "The design stage did not run" in summary
     assert "This run: NOT converged" in (out / "report" / f"corner_first_{unit(out, 'first')}.rst").read_text()
+
+
+def test_the_unit_rules_pass_a_ring_downs_windows_from_backbone_csv_to_calibrate_and_posterior(workdir):
+    """A ring-down run added to assembly first: modal_unit writes the unit's backbone.csv with its windows, the GA
+    reads its 20 windows as one read-out beside the twelve sweeps, and so does the posterior."""
+    out = workdir / "results"
+    modal = pd.read_csv(out / "modal" / "modal_properties.csv", dtype={"flags": str})
+    backbone = pd.read_csv(out / "modal" / "backbone.csv", dtype={"run_id": str, "mode": str})
+    mode = backbone.loc[backbone["run_id"].str.startswith("first"), "mode"].iloc[0]
+    t = TABLE_3_2["first"]
+    q = np.geomspace(1e-4, 3e-6, 20)
+    f, z = harmonic_balance(q, t["Fs"], t["KT"], t["chi"], t["beta"], t["k"], M, t["zeta_v"])
+    row = dict(run_id="first_rd", assembly="first", sequence=13, level_g=10.0, direction="", test="ringdown",
+               f_res_method="ringdown", q_in=q[0], f_res_hz=f[0], zeta_res=z[0], zeta_phase_resonance=z[0],
+               zeta_half_power=z[0], flags="")
+    pd.concat([modal, pd.DataFrame([row])], ignore_index=True).to_csv(out / "modal" / "modal_properties.csv",
+                                                                       index=False)
+    windows = pd.DataFrame({"run_id": "first_rd", "mode": mode, "test": "ringdown", "q_in": q, "f_hz": f, "zeta": z})
+    pd.concat([backbone, windows], ignore_index=True).to_csv(out / "modal" / "backbone.csv", index=False)
+    target = f"results/posterior/first/{mode}/summary.csv"
+    res = _snakemake(workdir, target)
+    assert res.returncode == 0, res.stderr
+    unit_bb = pd.read_csv(out / "modal" / "first" / mode / "backbone.csv")
+    assert (unit_bb["run_id"] == "first_rd").sum() == 20 and len(unit_bb) == 12 + 20
+    assert not unit_bb["run_id"].str.startswith("reassembly").any()
+    best = json.loads((out / "calibration" / "first" / mode / "ga_best.json").read_text())
+    assert (best["n_runs"], best["n_points"], best["n_readouts"]) == (13, 32, 13.0)
+    assert "(32 points, 13 read-outs)" in (out / "logs" / "calibrate" / "first" / f"{mode}.log").read_text()
+    assert "weight 1/20 each" in (out / "logs" / "posterior" / "first" / f"{mode}.log").read_text()
 
 
 def test_bad_input_is_one_sentence_naming_the_file(workdir):

@@ -2,14 +2,16 @@
 # GA checkpoints live in <results>/checkpoints/ (not declared outputs: Snakemake deletes
 # those before a rerun, and an interrupted GA resumes from its checkpoint).
 
-# One (assembly, mode)'s rows of the modal tables: what that unit's stages read.
+# One (assembly, mode)'s rows of the modal tables (and its runs' backbone points): what that unit's stages read.
 rule modal_unit:
     input:
         table=MODAL / "modal_properties.csv",
         scatter=MODAL / "scatter.csv",
+        backbone=MODAL / "backbone.csv",
     output:
         table=MODAL / "{assembly}" / "{mode}" / "modal_properties.csv",
         scatter=MODAL / "{assembly}" / "{mode}" / "scatter.csv",
+        backbone=MODAL / "{assembly}" / "{mode}" / "backbone.csv",
     params:
         code=source_hash("modal_unit.py"),
     wildcard_constraints:
@@ -27,6 +29,7 @@ rule modal_unit:
 rule calibrate_assembly:
     input:
         modal=MODAL / "{assembly}" / "{mode}" / "modal_properties.csv",
+        backbone=MODAL / "{assembly}" / "{mode}" / "backbone.csv",  # ring-down windows, dwells' phase resonance
     output:
         best=CALIBRATION / "{assembly}" / "{mode}" / "ga_best.json",
         history=CALIBRATION / "{assembly}" / "{mode}" / "ga_history.csv",

@@ -6,6 +6,7 @@ rule posterior_assembly:
     input:
         modal=MODAL / "{assembly}" / "{mode}" / "modal_properties.csv",
         scatter=MODAL / "{assembly}" / "{mode}" / "scatter.csv",
+        backbone=MODAL / "{assembly}" / "{mode}" / "backbone.csv",
         best=CALIBRATION / "{assembly}" / "{mode}" / "ga_best.json",
     output:
         summary=POSTERIOR / "{assembly}" / "{mode}" / "summary.csv",

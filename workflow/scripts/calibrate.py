@@ -14,6 +14,6 @@ with stage_job(snakemake) as job:  # noqa: F821 (provided by Snakemake)
     smk = job.smk
     settings = CalibrateSettings.from_config(smk.params.calibrate)
     _, notes = run_calibration(smk.input.modal, smk.wildcards.assembly, Path(smk.output.best).parent, settings,
-                               checkpoint=smk.params.checkpoint, progress=job.log)
+                               checkpoint=smk.params.checkpoint, progress=job.log, backbone_csv=smk.input.backbone)
     for n in notes:
         job.log(n)

@@ -19,8 +19,9 @@ with stage_job(snakemake) as job:  # noqa: F821 (provided by Snakemake)
     cal = CalibrateSettings.from_config(smk.params.calibrate)
     post = PosteriorSettings.from_config(smk.params.posterior)
     res, notes = run_posterior(smk.input.modal, smk.input.scatter, smk.input.best, asm, Path(smk.output.summary).parent,
-                               cal, post, checkpoint=smk.params.checkpoint, progress=job.log)
+                               cal, post, checkpoint=smk.params.checkpoint, progress=job.log,
+                               backbone_csv=smk.input.backbone)
     notes.append(write_identified(smk.input.modal, smk.input.best, smk.output.chain, asm, cal, post,
-                                  smk.output.identified))
+                                  smk.output.identified, backbone_csv=smk.input.backbone))
     for n in notes:
         (job.warn if "floor" in n or "NOT converged" in n else job.log)(n)

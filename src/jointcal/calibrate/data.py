@@ -2,8 +2,11 @@
 
 Reads ``modal_properties.csv`` (one row per run: ``run_id, assembly, q_in, f_res_hz``,
 the damping column named in the config, ``flags``; ``level_g`` or ``level_lbf`` is
-carried along when present) and ``scatter.csv``
-(tidy repeatability: ``assembly, quantity, level_g, source, n, mean, std, rel_std``).
+carried along when present), ``scatter.csv``
+(tidy repeatability: ``assembly, quantity, level_g, source, n, mean, std, rel_std``) and, when
+given, ``backbone.csv``: a ring-down then gives every window along its decay and a level's dwells
+their phase resonance, each read-out weighted once (`jointcal.calibrate._readouts`; without it,
+and for swept runs, one point per run of weight 1 as before).
 Rows whose ``flags`` name ``unusable``, or an ingest flag of wrong units or level,
 swapped channels, a constant channel or clipping (`jointcal.io.UNUSABLE_FLAGS`),
 are left out; other flags are informational.
@@ -26,13 +29,17 @@ from numpy.typing import NDArray
 
 from jointcal.io import UNUSABLE_FLAGS, level_column
 
-__all__ = ["CalibrationInputError", "ModalData", "DAMPING", "select_modal", "read_modal", "read_table"]
+from ._readouts import expand
+
+__all__ = ["CalibrationInputError", "ModalData", "DAMPING", "select_modal", "read_modal", "read_table",
+           "read_backbone", "BACKBONE_COLUMNS"]
 
 Damping = Literal["zeta_res", "zeta_phase_resonance", "zeta_half_power"]
 DAMPING: tuple[str, ...] = ("zeta_res", "zeta_phase_resonance", "zeta_half_power")
 FREQUENCY = "f_res_hz"
 _MODAL_COLUMNS = ("run_id", "assembly", "q_in", FREQUENCY, "flags")
 _SCATTER_COLUMNS = ("assembly", "quantity", "source", "rel_std")
+BACKBONE_COLUMNS = ("run_id", "mode", "test", "q_in", "f_hz", "zeta")  # jointcal.measure.testkinds
 
 
 class CalibrationInputError(ValueError):
@@ -61,6 +68,11 @@ class ModalData:
     rel_noise : (float, float) -- relative noise scale of f and zeta (pooled scatter,
         floored); NaN when no scatter table was read.
     notes : tuple of str -- exclusions and floors applied, for the log.
+    weight : ndarray, shape (N,), or None -- each point's weight in eq. 3.9 and the likelihood (a
+        ring-down's k windows 1/k each: `jointcal.calibrate._readouts`); None: 1 each.
+
+    The arrays hold one entry per point: per run, or per ring-down window and level of dwells when
+    the points came from backbone.csv (``run_id`` then repeats a run, or joins a level's dwells).
     """
 
     assembly: str
@@ -72,6 +84,17 @@ class ModalData:
     damping: str
     rel_noise: tuple[float, float]
     notes: tuple[str, ...]
+    weight: NDArray[np.float64] | None = None
+
+    @property
+    def w(self) -> NDArray[np.float64]:
+        """The points' weights, shape (N,): `weight`, or ones."""
+        return np.ones(self.q.size) if self.weight is None else np.asarray(self.weight, dtype=float)
+
+    @property
+    def n_readouts(self) -> float:
+        """The number of read-outs, sum(w): the N of eq. 3.9 (the number of points when all weigh 1)."""
+        return float(self.q.size) if self.weight is None else float(np.sum(self.weight))
 
 
 def _usable(flags: pd.Series) -> NDArray[np.bool_]:
@@ -101,7 +124,8 @@ def _pooled(scatter: pd.DataFrame, assembly: str, quantity: str, floor: float, w
 
 def select_modal(modal: pd.DataFrame, assembly: str, *, damping: Damping = "zeta_res",
                  scatter: pd.DataFrame | None = None, floors: Mapping[str, float] | None = None,
-                 modal_name: object = "modal_properties.csv", scatter_name: object = "scatter.csv") -> ModalData:
+                 modal_name: object = "modal_properties.csv", scatter_name: object = "scatter.csv",
+                 backbone: pd.DataFrame | None = None, backbone_name: object = "backbone.csv") -> ModalData:
     """Validate the modal tables and return one assembly's usable runs.
 
     Parameters
@@ -118,7 +142,9 @@ def select_modal(modal: pd.DataFrame, assembly: str, *, damping: Damping = "zeta
         The scatter table; without it ``rel_noise`` is (NaN, NaN).
     floors : mapping, optional
         ``{'frequency': 1e-4, 'damping': 0.01}``: smallest relative noise scales.
-    modal_name, scatter_name : object
+    backbone : pandas.DataFrame, optional
+        backbone.csv: with it, ring-down and dwell runs give their points (`jointcal.calibrate._readouts`).
+    modal_name, scatter_name, backbone_name : object
         How the files are named in error messages and notes.
 
     Returns
@@ -170,6 +196,17 @@ def select_modal(modal: pd.DataFrame, assembly: str, *, damping: Damping = "zeta
     level_col = level_column(rows.columns)
     level = (np.full(len(rows), np.nan) if level_col is None
              else pd.to_numeric(rows[level_col], errors="coerce").to_numpy(float))
+    run_id, weight = tuple(map(str, rows["run_id"])), None
+    method = rows["f_res_method"].astype(str) if "f_res_method" in rows else pd.Series([], dtype=str)
+    if backbone is not None and method.isin(["ringdown", "dwell"]).any():
+        missing = [c for c in BACKBONE_COLUMNS if c not in backbone.columns]
+        if missing:
+            _fail(backbone_name, f"column(s) {', '.join(missing)} missing (found: "
+                  f"{', '.join(map(str, backbone.columns))})", "regenerate it with the modal stage")
+        pts, more = expand(rows, backbone, level, ("q_in", FREQUENCY, damping), backbone_name)
+        notes += more
+        run_id, level, weight = tuple(map(str, pts["run_id"])), pts["level"], pts["weight"]
+        values = {"q_in": pts["q"], FREQUENCY: pts["f"], damping: pts["zeta"]}
     floors = {"frequency": 1e-4, "damping": 0.01, **(floors or {})}
     noise = (float("nan"), float("nan"))
     if scatter is not None:
@@ -179,9 +216,9 @@ def select_modal(modal: pd.DataFrame, assembly: str, *, damping: Damping = "zeta
                   f"(found: {', '.join(map(str, scatter.columns))})", "regenerate it with the modal stage")
         noise = (_pooled(scatter, str(assembly), FREQUENCY, floors["frequency"], scatter_name, notes),
                  _pooled(scatter, str(assembly), damping, floors["damping"], scatter_name, notes))
-    return ModalData(assembly=str(assembly), run_id=tuple(map(str, rows["run_id"])), level=level,
+    return ModalData(assembly=str(assembly), run_id=run_id, level=level,
                      q=values["q_in"], f=values[FREQUENCY], zeta=values[damping], damping=damping,
-                     rel_noise=noise, notes=tuple(notes))
+                     rel_noise=noise, notes=tuple(notes), weight=weight)
 
 
 def read_table(path: str | os.PathLike[str]) -> pd.DataFrame:
@@ -196,8 +233,20 @@ def read_table(path: str | os.PathLike[str]) -> pd.DataFrame:
 
 
 def read_modal(modal_csv: str | os.PathLike[str], assembly: str, *, scatter_csv: str | os.PathLike[str] | None = None,
-               damping: Damping = "zeta_res", floors: Mapping[str, float] | None = None) -> ModalData:
-    """`select_modal` on the files ``modal_properties.csv`` (and ``scatter.csv``)."""
+               damping: Damping = "zeta_res", floors: Mapping[str, float] | None = None,
+               backbone_csv: str | os.PathLike[str] | None = None) -> ModalData:
+    """`select_modal` on the files ``modal_properties.csv`` (and ``scatter.csv``, ``backbone.csv``)."""
     scatter = None if scatter_csv is None else read_table(scatter_csv)
+    backbone = None if backbone_csv is None else read_backbone(backbone_csv)
     return select_modal(read_table(modal_csv), assembly, damping=damping, scatter=scatter, floors=floors,
-                        modal_name=Path(modal_csv), scatter_name=None if scatter_csv is None else Path(scatter_csv))
+                        modal_name=Path(modal_csv), scatter_name=None if scatter_csv is None else Path(scatter_csv),
+                        backbone=backbone, backbone_name=None if backbone_csv is None else Path(backbone_csv))
+
+
+def read_backbone(path: str | os.PathLike[str]) -> pd.DataFrame:
+    """backbone.csv (`read_table`, run ids and modes as text)."""
+    table = read_table(path)
+    for col in ("run_id", "mode", "test"):
+        if col in table:
+            table[col] = table[col].astype(str)
+    return table

@@ -49,6 +49,10 @@ def _residuals(theta: NDArray[np.float64], data: ModalData, s: CalibrateSettings
     """Residual vectors whose squared norms are eq. 3.9, shape (P, 2N), for parameters theta (P, n) of `s.space`."""
     f_m, z_m = predict(s.space.joint(np.atleast_2d(theta)), data.q, m=s.m, model=s.model, viscous=s.viscous)
     n = data.q.size
+    if data.weight is not None:  # read-outs of many points: each residual times the square root of its weight
+        w, n = data.w, data.n_readouts
+        return np.concatenate([np.sqrt(s.eta * w / n) * (data.f - f_m) / data.f,
+                               np.sqrt((1.0 - s.eta) * w / n) * (data.zeta - z_m) / data.zeta], axis=1)
     return np.concatenate([np.sqrt(s.eta / n) * (data.f - f_m) / data.f,
                            np.sqrt((1.0 - s.eta) / n) * (data.zeta - z_m) / data.zeta], axis=1)
 
@@ -208,7 +212,7 @@ def calibrate(data: ModalData, s: CalibrateSettings, *, resume: dict[str, Any] |
 
     def batch(u: NDArray[np.float64]) -> NDArray[np.float64]:
         return objective(space.joint(space.to_physical(u)), data.q, data.f, data.zeta, m=s.m, eta=s.eta, model=s.model,
-                         viscous=s.viscous, valid=space.inside(u))
+                         viscous=s.viscous, valid=space.inside(u), weight=data.weight)
 
     ga = search(batch, space, s.ga, resume=resume, on_checkpoint=on_checkpoint)
     u_best = ga.best
@@ -220,20 +224,29 @@ def calibrate(data: ModalData, s: CalibrateSettings, *, resume: dict[str, Any] |
         u_best = refined[int(np.argmin(batch(refined)))]
     theta = space.to_physical(u_best)
     value = float(batch(u_best[None])[0])
-    r = _residuals(theta, data, s)[0]
     n = data.q.size
+    if data.weight is None:  # one point per run
+        r = _residuals(theta, data, s)[0]
+        rms = [float(np.sqrt(np.mean((r[:n] / np.sqrt(s.eta / n)) ** 2))) if s.eta > 0 else None,
+               float(np.sqrt(np.mean((r[n:] / np.sqrt((1 - s.eta) / n)) ** 2))) if s.eta < 1 else None]
+    else:  # the weighted rms over read-outs
+        f_m, z_m = predict(space.joint(theta[None]), data.q, m=s.m, model=s.model, viscous=s.viscous)
+        rms = [float(np.sqrt(np.sum(data.w * r**2) / data.n_readouts))
+               for r in ((data.f - f_m[0]) / data.f, (data.zeta - z_m[0]) / data.zeta)]
     phi_max = float(space.phi_max(theta))
     best: dict[str, Any] = space.named(theta)
     best.update(
         objective=value, objective_ga=ga.best_value, n_polish=s.n_polish, seed=s.ga.seed,
         generations=ga.generations, stop_reason=ga.stop_reason, n_evaluations=int(len(ga.history)),
         model=s.model, viscous=s.viscous, damping=data.damping, eta=s.eta, m=s.m, assembly=data.assembly,
-        n_runs=n, q_min_in=float(data.q.min()), q_max_in=float(data.q.max()), phi_max_in=phi_max,
+        n_runs=n if data.weight is None else len({r for ids in data.run_id for r in ids.split("+")}),
+        q_min_in=float(data.q.min()), q_max_in=float(data.q.max()), phi_max_in=phi_max,
         f0_hz=float(np.sqrt(space.stuck_stiffness(theta) / s.m) / (2 * np.pi)),
-        rms_rel_residual_f=float(np.sqrt(np.mean((r[:n] / np.sqrt(s.eta / n)) ** 2))) if s.eta > 0 else None,
-        rms_rel_residual_zeta=(float(np.sqrt(np.mean((r[n:] / np.sqrt((1 - s.eta) / n)) ** 2)))
-                               if s.eta < 1 else None),
+        rms_rel_residual_f=rms[0] if s.eta > 0 else None,
+        rms_rel_residual_zeta=rms[1] if s.eta < 1 else None,
     )
+    if data.weight is not None:  # a ring-down's windows: points and read-outs are not runs
+        best.update(n_points=n, n_readouts=data.n_readouts)
     history = pd.DataFrame(space.to_physical(ga.evaluated), columns=list(space.names))
     history.insert(0, "objective", ga.objectives)
     history.insert(0, "generation", ga.generation_of)

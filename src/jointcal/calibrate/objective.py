@@ -4,9 +4,12 @@ Gamma(p) = eta/N sum_i ((f_i - f~(q_i, p))/f_i)^2
          + (1 - eta)/N sum_i ((zeta_i - zeta~(q_i, p))/zeta_i)^2
 
 on the measured resonance amplitude q_i (in), frequency f_i (Hz) and damping ratio
-zeta_i of each usable run. The model is `harmonic_balance` (default: the frequency a
-steady sweep shows at phase resonance) or `qsma` (the paper's quasi-static modal
-analysis, 0.15-0.35% stiffer). The viscous term follows the convention named by
+zeta_i of each usable run. Where a run gives many points (a ring-down's windows), each
+squared residual carries the point's weight w_i and N = sum w_i, the number of read-outs
+(`jointcal.calibrate._readouts`); with one point per run every w_i is 1.
+
+The model is `harmonic_balance` (default: the frequency a steady sweep shows at phase
+resonance) or `qsma` (the paper's quasi-static modal analysis, 0.15-0.35% stiffer). The viscous term follows the convention named by
 ``viscous`` (see `jointcal.models.amplitude`): ``"dashpot"`` (default for both models,
 so zeta_v means the same physical dashpot whichever model is fitted, and matches what
 a time simulation or a test with a linear dashpot shows) or ``"constant"`` (the paper's
@@ -67,7 +70,7 @@ def predict(theta: ArrayLike, q: ArrayLike, *, m: float, model: Model = "harmoni
 
 def objective(theta: ArrayLike, q: ArrayLike, f: ArrayLike, zeta: ArrayLike, *, m: float, eta: float = 0.85,
               model: Model = "harmonic_balance", viscous: Literal["dashpot", "constant"] = "dashpot",
-              valid: ArrayLike | None = None) -> NDArray[np.float64]:
+              valid: ArrayLike | None = None, weight: ArrayLike | None = None) -> NDArray[np.float64]:
     """Eq. 3.9 for each row of `theta`.
 
     Parameters
@@ -84,6 +87,8 @@ def objective(theta: ArrayLike, q: ArrayLike, f: ArrayLike, zeta: ArrayLike, *, 
         See `predict`.
     valid : array_like of bool, shape (P,), optional
         Rows to evaluate (e.g. those inside the bounds); the others get `PENALTY`.
+    weight : array_like, shape (N,), optional
+        Each point's weight (`jointcal.calibrate.ModalData.w`); default 1 each.
 
     Returns
     -------
@@ -103,8 +108,14 @@ def objective(theta: ArrayLike, q: ArrayLike, f: ArrayLike, zeta: ArrayLike, *, 
         return out
     with np.errstate(all="ignore"):
         f_m, z_m = predict(theta[ok], q, m=m, model=model, viscous=viscous)
-        n = f.size
-        gamma = (eta / n) * np.sum(((f - f_m) / f) ** 2, axis=1)  # eq. 3.9, frequency term
-        gamma += ((1.0 - eta) / n) * np.sum(((zeta - z_m) / zeta) ** 2, axis=1)  # eq. 3.9, damping term
+        if weight is None:
+            n = f.size
+            gamma = (eta / n) * np.sum(((f - f_m) / f) ** 2, axis=1)  # eq. 3.9, frequency term
+            gamma += ((1.0 - eta) / n) * np.sum(((zeta - z_m) / zeta) ** 2, axis=1)  # eq. 3.9, damping term
+        else:  # eq. 3.9 over read-outs: each point's squared residual times its weight, N = sum of the weights
+            w = np.asarray(weight, dtype=float)
+            n = float(np.sum(w))
+            gamma = (eta / n) * np.sum(w * ((f - f_m) / f) ** 2, axis=1)
+            gamma += ((1.0 - eta) / n) * np.sum(w * ((zeta - z_m) / zeta) ** 2, axis=1)
     out[ok] = np.where(np.isfinite(gamma), np.minimum(gamma, PENALTY), PENALTY)
     return out

@@ -24,7 +24,7 @@ from pathlib import Path
 from dataclasses import replace
 
 from ..io import write_bytes_atomic, write_csv_atomic, write_json_atomic
-from .data import ModalData, read_table, select_modal
+from .data import ModalData, read_backbone, read_table, select_modal
 from .fit import Calibration, calibrate
 from .kind import data_bounds, excitation_of_table, kind_of
 from .settings import CalibrateSettings
@@ -40,13 +40,13 @@ def fingerprint(data: ModalData, s: CalibrateSettings) -> str:
     cfg = dict(model=s.model, viscous=s.viscous, damping=s.damping, eta=s.eta, m=s.m, kind=s.model_kind,
                bounds=s.full_bounds, ga=ga)
     h = hashlib.sha256(json.dumps(cfg, sort_keys=True).encode())
-    for a in (data.q, data.f, data.zeta):
+    for a in (data.q, data.f, data.zeta) + (() if data.weight is None else (data.w,)):
         h.update(a.tobytes())
     return h.hexdigest()
 
 
-def resolve(settings: CalibrateSettings, modal, assembly: str, *,
-            modal_name: object = "modal_properties.csv") -> tuple[CalibrateSettings, ModalData, str]:
+def resolve(settings: CalibrateSettings, modal, assembly: str, *, modal_name: object = "modal_properties.csv",
+            backbone=None, backbone_name: object = "backbone.csv") -> tuple[CalibrateSettings, ModalData, str]:
     """The settings made concrete for one assembly's data: model kind, mass and all six bounds.
 
     Parameters
@@ -56,6 +56,8 @@ def resolve(settings: CalibrateSettings, modal, assembly: str, *,
     modal : DataFrame
         The modal stage's table.
     assembly : str
+    backbone : DataFrame, optional
+        backbone.csv: ring-down and dwell runs then give their points (`jointcal.calibrate.select_modal`).
 
     Returns
     -------
@@ -65,7 +67,8 @@ def resolve(settings: CalibrateSettings, modal, assembly: str, *,
     """
     excitation = excitation_of_table(modal)
     kind = kind_of(settings.model_kind, excitation)
-    data = select_modal(modal, assembly, damping=settings.damping, modal_name=modal_name)  # type: ignore[arg-type]
+    data = select_modal(modal, assembly, damping=settings.damping, modal_name=modal_name,  # type: ignore[arg-type]
+                        backbone=backbone, backbone_name=backbone_name)
     s = replace(settings, model_kind=kind, bounds=dict(settings.bounds))
     if kind == "modal":
         s = replace(s, bounds={**data_bounds(data.q, data.f, data.zeta, s.m), **dict(settings.bounds)})
@@ -76,7 +79,8 @@ def resolve(settings: CalibrateSettings, modal, assembly: str, *,
 
 def run_calibration(modal_csv: str | os.PathLike[str], assembly: str, out_dir: str | os.PathLike[str],
                     settings: CalibrateSettings, *, checkpoint: str | os.PathLike[str] | None = None,
-                    progress: Callable[[str], None] | None = None) -> tuple[Calibration, list[str]]:
+                    progress: Callable[[str], None] | None = None,
+                    backbone_csv: str | os.PathLike[str] | None = None) -> tuple[Calibration, list[str]]:
     """Calibrate one assembly from ``modal_properties.csv`` and write the stage's outputs.
 
     Parameters
@@ -93,6 +97,9 @@ def run_calibration(modal_csv: str | os.PathLike[str], assembly: str, out_dir: s
     progress : callable, optional
         Receives one line (generation, best objective, stall count) every
         ``checkpoint_every`` generations, for the stage's log.
+    backbone_csv : path-like, optional
+        The unit's ``backbone.csv``: a ring-down gives its windows, a level's dwells their phase resonance,
+        each read-out weighted once (`jointcal.calibrate._readouts`).
 
     Returns
     -------
@@ -105,7 +112,9 @@ def run_calibration(modal_csv: str | os.PathLike[str], assembly: str, out_dir: s
     jointcal.calibrate.CalibrationInputError
         The modal table breaks its contract (one sentence naming the file).
     """
-    settings, data, excitation = resolve(settings, read_table(modal_csv), assembly, modal_name=Path(modal_csv))
+    backbone = None if backbone_csv is None else read_backbone(backbone_csv)
+    settings, data, excitation = resolve(settings, read_table(modal_csv), assembly, modal_name=Path(modal_csv),
+                                         backbone=backbone, backbone_name=backbone_csv)
     notes = list(data.notes)
     notes.append(f"model kind {settings.model_kind} ({excitation}-driven runs), m = {settings.m:.6g} lbf s^2/in"
                  + (" (per unit modal mass)" if settings.model_kind == "modal" and settings.modal_mass is None else "")
@@ -145,7 +154,8 @@ def run_calibration(modal_csv: str | os.PathLike[str], assembly: str, out_dir: s
     write_csv_atomic(cal.logbook, out / "ga_logbook.csv")
     write_csv_atomic(cal.curves, out / "model_curves.csv")
     b = cal.best
-    notes.append(f"calibrated {assembly!r} on {b['n_runs']} runs ({settings.model}, eta {settings.eta}, "
+    points = "" if data.weight is None else f" ({b['n_points']} points, {b['n_readouts']:g} read-outs)"
+    notes.append(f"calibrated {assembly!r} on {b['n_runs']} runs{points} ({settings.model}, eta {settings.eta}, "
                  f"{settings.damping}): objective {b['objective']:.6g} (GA alone {b['objective_ga']:.6g}) after "
                  f"{b['generations']} generations ({b['stop_reason']}), {b['n_evaluations']} evaluations")
     return cal, notes

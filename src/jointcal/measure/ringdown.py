@@ -12,33 +12,50 @@ The estimator (``ringdown_backbone``), in the order data flows:
    at which the band-passed response's envelope lies within `HOLD` of its plateau (the end of a
    dwell's steady state, or just after an impact's peak).
 2. **One mode**: the response is band-passed around the mode, zero phase (`scipy.signal.sosfiltfilt`,
-   4th-order Butterworth over f (1 -+ `BAND`)), over the whole record, so the decay's start is no edge of
-   the filter; a softening mode moves by a few per cent, well inside the band. The first `SETTLE` periods
-   after the cut-off are left out: the filter's response to the cut itself (a linear decay read from the
-   cut: f -0.5%, zeta -60% in the first window).
-3. **Damped sinusoid fits in sliding windows** of `cycles` periods, stepping by half a window:
-   x(t) = exp(-sigma t) (a cos w t + b sin w t) by least squares, w and sigma by Gauss-Newton, a and b by
-   variable projection. Unlike the Hilbert transform's instantaneous amplitude and phase, a window fit
-   has no end effects to trim and averages the noise over the window; its frequency and decay rate are
-   those of the window's mean amplitude (the decay's envelope changes by exp(-2 pi zeta cycles) over a
-   window: 6% at zeta = 0.01 and 6 cycles, whose curvature biases the read-out by less than 0.1%).
+   4th-order Butterworth over f (1 -+ `BAND`)); a softening mode moves by a few per cent, well inside
+   the band. The filter would smear the forced response before the cut into the decay's first periods
+   (on the virtual Ministack +-8% in zeta over its first 7 periods), so the decay is filtered apart,
+   preceded by `EXTEND` periods of its own continuation backwards: the damped sinusoid fitted to its
+   first window, raw and then once more band-passed. The first `SETTLE` period is left out (the
+   drive's last sample above `DRIVE_OFF` lies within the DAQ filter's ring after the cut). Where the
+   raw first window is not one damped sinusoid (its misfit above `MISFIT_MAX`: other modes ring from
+   the start, as after an impact), one mode's continuation would start the others abruptly at the
+   junction (a 41 Hz mode 1.5x an 18.6 Hz one: zeta 11% off in its first window), so the whole record
+   is band-passed, the first `SETTLE_MIXED` periods left out and the windows start twice as long (an
+   18.6 Hz mode with modes at 7 and 41 Hz, 0.5x and 1.5x, from the impact, 18 onset phases: zeta
+   within 6.8% from 3 periods, 2.9% from 4, 1.9% from 5; 6-period windows from 3 periods had 7.7%).
+3. **Damped sinusoid fits in sliding windows** (`jointcal.measure._decay_window.fit_window`): decay
+   rate and frequency at the window's centre, each drifting linearly over it, by variable projection.
+   A window is `MIN_CYCLES` periods long while the noise allows; where its decay rate's standard
+   error exceeds `ZETA_SE_MAX` of the rate, it grows by `GROW` until the error is met or the window
+   spans `SPAN_MAX` e-folds of the decay (a fast decay's amplitude falls by 10% a period, so the
+   information a window holds about its rate is bounded by the span of amplitude it covers, not by
+   its number of periods). Windows step by half their length.
 4. Each window gives ``f_hz`` = w_n / (2 pi) with w_n = sqrt(w^2 + sigma^2) (the undamped natural
    frequency: the damped one is lower by zeta^2 / 2), ``zeta`` = sigma / w_n, and the displacement
-   amplitude at its centre ``q_in`` = |a + i b| exp(-sigma t_c) G / w_n^2 (in; the response in g).
-5. **The noise floor**: the decay is read while the standard error of the window's decay rate that
-   the noise gives (the smaller of two upper bounds of the noise: the band-passed record's rms over
-   its last `TAIL`, where the decay has died out, and the window fit's residual rms, which also holds
-   the model's error; times sqrt((J^T J)^-1) of the fit and sqrt(fs / 2B), since the band-passed noise holds one
-   independent sample in fs / 2B, B = 2 BAND f) is at most `ZETA_SE_MAX` of it, so
-   that three standard errors stay within 3% in zeta (a linear decay at zeta = 0.5% under noise:
-   per-window errors of 1-2% where the decay stands 80-2000x over the noise's rms, 13% at 10-20x, which
-   an amplitude threshold alone would have kept); the windows after are dropped and the row of the
-   last kept window is flagged ``noise_floor``. A window whose fit residual exceeds `MISFIT_MAX` of its amplitude (a beating with a
-   close mode, a clipped start) is flagged ``misfit`` and kept, marked.
+   amplitude at its centre ``q_in`` = |a + i b| G / w_n^2 (in; the response in g). Read from the
+   acceleration: its envelope decays more slowly than the displacement's by 2 dw/dt / w (a softening
+   joint's frequency rises as it decays), and it is this rate that the first-harmonic balance's
+   zeta(q) w_n(q) matches (the exact Iwan's Ministack ring-down: acceleration within 0.2-0.6%,
+   displacement 1-2% faster).
+5. **The noise floor**: the decay is read while the standard error of the window's decay rate is at
+   most `ZETA_SE_MAX` of it, so that three standard errors stay within 3% in zeta. The noise is the
+   band-passed record's rms over its last `TAIL` (the decay has died out), or, where the window holds
+   more than twice as many independent noise samples as the fit's six parameters, the smaller of that
+   and the fit's residual rms corrected for the parameters' degrees of freedom; times sqrt((J^T J)^-1)
+   of the fit and sqrt(fs / 2B), since the band-passed noise holds one independent sample in fs / 2B,
+   B = 2 BAND f. The windows after the first that misses are dropped and the row of the last kept
+   window is flagged ``noise_floor``. A window whose fit residual exceeds `MISFIT_MAX` of its
+   amplitude (a beating with a close mode, a clipped start) is flagged ``misfit`` and kept, marked.
 
-Checked against closed forms (tests/measure/test_ringdown.py): a linear mode's decay gives its f and
-zeta to 1e-5 and 1e-3; the exact Iwan simulator's ring-down gives the first-harmonic balance backbone
-within 0.1% and 3% over 1.5 decades of amplitude.
+Checked against closed forms (tests/test_ringdown.py): a linear mode's decay at 5800x over the noise
+gives its f within 8e-5 and zeta within 1.3% over three decades; the exact Iwan simulator's 100 Hz
+ring-down the first-harmonic balance backbone within 0.017% and 1.9% over 3.1 decades. The virtual
+Ministack at 0.1% noise (tests/test_synth_steady.py; 2.3 kHz, zeta 1.5% falling to 0.4%, the
+amplitude 10% down each period at the start) reads 1.66-2.12 decades per ring-down within 0.062% in
+f and 2.9% in zeta (36 decays, six seeds), where 6-period windows from 3 periods after the cut had
+read 0.69-0.80 decades: the noise floor's rule stopped them once a fixed window's decay rate was
+noisier than 1%, and the band-pass's smear of the cut cost the first 0.3 decades.
 """
 from __future__ import annotations
 
@@ -48,8 +65,10 @@ from numpy.typing import NDArray
 from scipy import signal
 
 from ..units import G
+from ._decay_window import fit_window
 
-__all__ = ["decay_start", "ringdown_backbone", "DRIVE_OFF", "HOLD", "BAND", "ZETA_SE_MAX", "MISFIT_MAX", "SETTLE", "TAIL"]
+__all__ = ["decay_start", "ringdown_backbone", "DRIVE_OFF", "HOLD", "BAND", "ZETA_SE_MAX", "MISFIT_MAX", "SETTLE",
+           "TAIL", "MIN_CYCLES", "GROW", "SPAN_MAX", "EXTEND", "SETTLE_MIXED"]
 
 DRIVE_OFF = 0.02  # a drive below this share of its largest value is off
 HOLD = 0.05  # without a drive: the decay starts where the envelope last lies within this share of its plateau
@@ -57,7 +76,13 @@ BAND = 0.3  # band-pass half-width, relative to the mode's frequency
 ZETA_SE_MAX = 0.01  # a window is read while its decay rate's standard error is below this share of it
 TAIL = 0.1  # share of the record at its end whose band-passed rms is the noise (the decay has died out)
 MISFIT_MAX = 0.05  # relative rms residual of a window fit above which it is not one decaying mode
-SETTLE = 3.0  # periods after the cut-off before the first window: the band-pass filter's response to the cut
+SETTLE = 1.0  # periods after the decay's start before the first window: the DAQ filter's ring at the cut-off
+SETTLE_MIXED = 5.0  # the same where other modes ring from the start: their onsets' ring through the band-pass
+MIN_CYCLES = 3.0  # the shortest window, periods of the mode
+GROW = 1.25  # a window too short for the noise grows by this factor
+SPAN_MAX = 2.0  # a window covers at most this many e-folds of the decay (sigma * length): amplitude / 7.4
+EXTEND = 20.0  # periods of the decay's backward continuation ahead of it when band-passing it apart
+PARAMS = 6  # the window fit's parameters: a, b, w, sigma and their drifts
 
 
 def decay_start(fs: float, response: NDArray, drive: NDArray | None = None) -> int:
@@ -100,38 +125,30 @@ def decay_start(fs: float, response: NDArray, drive: NDArray | None = None) -> i
     return int(end)
 
 
-def _fit_window(t: NDArray, x: NDArray, w0: float) -> tuple[float, float, complex, float, float]:
-    """Fit x ~ exp(-sigma t) (a cos wt + b sin wt), t centred on the window.
+def _centred(n: int, fs: float) -> NDArray:
+    return (np.arange(n) - (n - 1) / 2) / fs
 
-    Returns w, sigma, a + i b, the relative rms residual and the standard error of sigma per unit
-    white-noise rms (sqrt of (J^T J)^-1's sigma entry, over the four parameters).
-    """
-    w, sig = w0, 0.0
-    for _ in range(30):
-        e = np.exp(-sig * t)
-        B = np.column_stack([e * np.cos(w * t), e * np.sin(w * t)])
-        (a, b), *_ = np.linalg.lstsq(B, x, rcond=None)
-        r = x - B @ [a, b]
-        J = np.column_stack([e * t * (-a * np.sin(w * t) + b * np.cos(w * t)), -t * (B @ [a, b])])
-        step, *_ = np.linalg.lstsq(J, r, rcond=None)
-        w, sig = w + step[0], sig + step[1]
-        if abs(step[0]) < 1e-10 * w and abs(step[1]) < 1e-9 * w:
-            break
-    e = np.exp(-sig * t)
-    B = np.column_stack([e * np.cos(w * t), e * np.sin(w * t)])
-    (a, b), *_ = np.linalg.lstsq(B, x, rcond=None)
-    r = x - B @ [a, b]
-    J = np.column_stack([e * t * (-a * np.sin(w * t) + b * np.cos(w * t)), -t * (B @ [a, b]), B])
-    try:
-        se_sigma = float(np.sqrt(np.linalg.inv(J.T @ J)[1, 1]))
-    except np.linalg.LinAlgError:
-        se_sigma = np.inf
-    res = float(np.sqrt(np.mean(r**2)) / max(np.hypot(a, b) / np.sqrt(2), 1e-300))
-    return float(w), float(sig), complex(a, b), res, se_sigma
+
+def _band_passed_decay(x: NDArray, y: NDArray, i0: int, sos, n: int, fs: float, f_hz: float) -> NDArray | None:
+    """`y` (the whole record band-passed) with its decay from `i0` on band-passed apart, after `EXTEND`
+    periods of its own damped sinusoid continued backwards (fitted to its first `n` samples: raw, then once
+    band-passed), so that the filter sees no forced response and no edge at the decay's start; None where the
+    raw decay's first window is not one damped sinusoid (its misfit above `MISFIT_MAX`: other modes ring from
+    the start, and a continuation of this mode alone would start them abruptly at the junction)."""
+    pad = int(round(EXTEND * fs / f_hz))
+    t_pad = (np.arange(-pad, 0) - (n - 1) / 2) / fs
+    src = x
+    for k in range(2):
+        w, sig, c, misfit, _ = fit_window(_centred(n, fs), src[i0:i0 + n], 2 * np.pi * f_hz)
+        if k == 0 and misfit > MISFIT_MAX:
+            return None
+        cont = np.exp(-sig * t_pad) * (c.real * np.cos(w * t_pad) + c.imag * np.sin(w * t_pad))
+        src = np.concatenate([y[:i0], signal.sosfiltfilt(sos, np.concatenate([cont, x[i0:]]))[pad:]])
+    return src
 
 
 def ringdown_backbone(response_g: NDArray, fs: float, f_hz: float, *, start: int | None = None,
-                      drive: NDArray | None = None, cycles: float = 6.0) -> pd.DataFrame:
+                      drive: NDArray | None = None, min_cycles: float = MIN_CYCLES) -> pd.DataFrame:
     """Frequency and damping of one mode along its free decay, against its amplitude.
 
     Parameters
@@ -146,40 +163,57 @@ def ringdown_backbone(response_g: NDArray, fs: float, f_hz: float, *, start: int
         First sample of the decay; default `decay_start` (from `drive` when given).
     drive : ndarray, shape (n,), optional
         The drive channel, to find where it was cut off.
-    cycles : float
-        Window length in periods of the mode.
+    min_cycles : float
+        The shortest window, periods of the mode (windows grow where the noise asks for it).
 
     Returns
     -------
     DataFrame
         One row per window, in time order: ``t_s`` (window centre, s from the record's start),
-        ``q_in`` (displacement amplitude, in), ``f_hz`` (undamped natural frequency, Hz), ``zeta``,
-        ``zeta_se`` (its standard error), ``misfit`` (relative rms residual), ``flags`` (``noise_floor`` on the last row read,
-        ``misfit``).
+        ``window_s`` (its length, s), ``q_in`` (displacement amplitude, in), ``f_hz`` (undamped natural
+        frequency, Hz), ``zeta``, ``zeta_se`` (its standard error from the noise), ``misfit`` (relative rms
+        residual), ``flags`` (``noise_floor`` on the last row read, ``misfit``).
     """
     x = np.nan_to_num(np.asarray(response_g, float))
     if not (np.isfinite(f_hz) and 0 < f_hz * (1 + BAND) < fs / 2):
         raise ValueError(f"the mode's frequency {f_hz!r} Hz must lie below the record's Nyquist frequency {fs / 2:g} Hz.")
     sos = signal.butter(4, [f_hz * (1 - BAND), f_hz * (1 + BAND)], btype="bandpass", fs=fs, output="sos")
-    y = signal.sosfiltfilt(sos, x - np.median(x))
+    x = x - np.median(x)
+    y = signal.sosfiltfilt(sos, x)
     i0 = decay_start(fs, y, drive) if start is None else int(start)
-    n_win = max(16, int(round(cycles * fs / f_hz)))
-    noise = float(np.sqrt(np.mean(y[-max(n_win, int(TAIL * y.size)):] ** 2)))  # where the decay has died out
-    w0 = 2 * np.pi * f_hz
-    rows = []
-    settle = int(round(SETTLE * fs / f_hz))  # the band-pass's own ring at the cut-off
-    for lo in range(i0 + settle, y.size - n_win, max(1, n_win // 2)):
-        t = (np.arange(n_win) - (n_win - 1) / 2) / fs
-        w, sig, c, res, se_sig = _fit_window(t, y[lo:lo + n_win], w0)
-        window_noise = min(noise, res * abs(c) / np.sqrt(2))  # each an upper bound: the tail, the fit's residual
-        se_sig *= window_noise * np.sqrt(fs / (4 * BAND * f_hz))  # one independent noise sample in fs / 2B
-        wn = float(np.hypot(w, sig))
-        if not (sig > 0 and se_sig <= ZETA_SE_MAX * sig and 0.5 * w0 < w < 1.5 * w0):
+    n = max(16, int(round(min_cycles * fs / f_hz)))
+    noise = float(np.sqrt(np.mean(y[-max(n, int(TAIL * y.size)):] ** 2)))  # where the decay has died out
+    apart = _band_passed_decay(x, y, i0, sos, n, fs, f_hz) if i0 + n <= y.size else None
+    settle = SETTLE
+    if apart is None:  # other modes from the start: the whole record band-passed, read after their onsets' ring
+        settle, n = SETTLE_MIXED, 2 * n
+    else:
+        y = apart
+    per_sample = np.sqrt(fs / (4 * BAND * f_hz))  # one independent noise sample in fs / 2B
+    w0, sig0, rows = 2 * np.pi * f_hz, 0.0, []
+    lo = i0 + int(round(settle * fs / f_hz))
+    while lo + n <= y.size:
+        w, sig, c, res, se_sig = fit_window(_centred(n, fs), y[lo:lo + n], w0, sig0)
+        n_eff = n / per_sample**2
+        window_noise = noise  # the tail; the residual too where it holds enough independent samples
+        if n_eff > 2 * PARAMS:
+            window_noise = min(noise, res * abs(c) / np.sqrt(2) / np.sqrt(1 - PARAMS / n_eff))
+        se_sig *= window_noise * per_sample
+        good = sig > 0 and 0.5 * w0 < w < 1.5 * w0
+        longer = int(n * GROW) + 1
+        if good and se_sig > ZETA_SE_MAX * sig and sig * longer / fs <= SPAN_MAX and lo + longer <= y.size:
+            n = longer  # too short for the noise: the same start, a longer window
+            continue
+        if not (good and se_sig <= ZETA_SE_MAX * sig):
             if not rows:  # not yet read: the loud start (the joint's distortion in the residual) may be past
+                lo += max(1, n // 2)
                 continue
             rows[-1]["flags"] = ";".join(filter(None, [rows[-1]["flags"], "noise_floor"]))
             break
-        rows.append(dict(t_s=(lo + (n_win - 1) / 2) / fs, q_in=abs(c) * G / wn**2, f_hz=wn / (2 * np.pi),
-                         zeta=sig / wn, zeta_se=se_sig / wn, misfit=res, flags="misfit" if res > MISFIT_MAX else ""))
-        w0 = w
-    return pd.DataFrame(rows, columns=["t_s", "q_in", "f_hz", "zeta", "zeta_se", "misfit", "flags"])
+        wn = float(np.hypot(w, sig))
+        rows.append(dict(t_s=(lo + (n - 1) / 2) / fs, window_s=n / fs, q_in=abs(c) * G / wn**2,
+                         f_hz=wn / (2 * np.pi), zeta=sig / wn, zeta_se=se_sig / wn, misfit=res,
+                         flags="misfit" if res > MISFIT_MAX else ""))
+        w0, sig0 = w, sig
+        lo += max(1, n // 2)
+    return pd.DataFrame(rows, columns=["t_s", "window_s", "q_in", "f_hz", "zeta", "zeta_se", "misfit", "flags"])

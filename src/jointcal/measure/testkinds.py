@@ -189,7 +189,7 @@ def backbone_table(modal: pd.DataFrame, points: list[dict]) -> pd.DataFrame:
     usable = ~modal["flags"].fillna("").str.contains(UNUSABLE)
     method = modal["f_res_method"] if "f_res_method" in modal else pd.Series("", index=modal.index)
     sweep = ~method.isin(["dwell", "ringdown"])
-    rows = modal.loc[usable & sweep]
+    rows = modal.loc[usable & sweep].reindex(columns=["run_id", "mode", "q_in", "f_res_hz", "zeta_res"])
     out = [pd.DataFrame({"run_id": rows["run_id"], "mode": rows["mode"], "test": "sweep", "q_in": rows["q_in"],
                          "f_hz": rows["f_res_hz"], "zeta": rows["zeta_res"]})]
     bad = set(modal.loc[~usable, "run_id"])

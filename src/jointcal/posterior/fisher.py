@@ -60,7 +60,7 @@ def unit_jacobian(fn: Callable[[NDArray[np.float64]], NDArray[np.float64]], u: N
 
 def fisher(theta: ArrayLike, sigma: ArrayLike, q: ArrayLike, f: ArrayLike, zeta: ArrayLike, space: ParamSpace, *,
            m: float, model: str = "harmonic_balance", viscous: str = "dashpot",
-           h: float = 1e-6) -> NDArray[np.float64]:
+           h: float = 1e-6, weight: ArrayLike | None = None) -> NDArray[np.float64]:
     """Fisher information of frequency and damping read-outs in the unit cube, at each draw.
 
     The residuals are those of the likelihood (`jointcal.posterior.likelihood`): (f_i -
@@ -82,6 +82,8 @@ def fisher(theta: ArrayLike, sigma: ArrayLike, q: ArrayLike, f: ArrayLike, zeta:
         As the calibration.
     h : float
         Finite-difference step in the unit cube.
+    weight : array_like, shape (N,), optional
+        Each read-out's weight in the likelihood (a ring-down's windows 1/k each); default 1.
 
     Returns
     -------
@@ -101,6 +103,8 @@ def fisher(theta: ArrayLike, sigma: ArrayLike, q: ArrayLike, f: ArrayLike, zeta:
 
     _, jac = unit_jacobian(fn, space.to_unit(theta), space, h=h)
     scale = np.concatenate([1.0 / (f * sigma[:, :1]), 1.0 / (zeta * sigma[:, 1:])], axis=1)  # (P, 2N)
+    if weight is not None:
+        scale = scale * np.sqrt(np.tile(np.asarray(weight, dtype=float), 2))
     G = np.where(np.isfinite(jac), jac, 0.0) * scale[:, :, None]
     return np.einsum("pki,pkj->pij", G, G)
 

@@ -42,6 +42,8 @@ def goodness_of_fit(lp: LogPosterior, theta: np.ndarray, p_reject: float = P_REJ
     r_f, r_z = lp.residuals(x[None])
     s_f, s_z = lp.data.rel_noise
     rms = [float(np.sqrt(np.mean(r_f**2))), float(np.sqrt(np.mean(r_z**2)))]
+    if lp.data.weight is not None:  # over read-outs (a ring-down's windows 1/k each)
+        rms = [float(np.sqrt(np.sum(lp.data.w * r**2) / lp.data.n_readouts)) for r in (r_f, r_z)]
     ratios = [rms[0] / s_f, rms[1] / s_z]
     test = fit_test(lp, theta)
     stat, dof, p = test["fit_chi2"], int(test["fit_dof"]), test["fit_p"]
@@ -64,4 +66,8 @@ def fit_test(lp: LogPosterior, theta: np.ndarray) -> dict[str, float]:
     s_f, s_z = lp.data.rel_noise
     stat = float(np.sum((r_f / s_f) ** 2) + np.sum((r_z / s_z) ** 2))
     dof = max(2 * r_f.size - len(theta), 1)
+    if lp.data.weight is not None:  # read-outs, not points: a ring-down's windows share one degree of freedom
+        w = lp.data.w
+        stat = float(np.sum(w * (r_f / s_f) ** 2) + np.sum(w * (r_z / s_z) ** 2))
+        dof = max(2 * lp.data.n_readouts - len(theta), 1)
     return {"fit_chi2": stat, "fit_dof": float(dof), "fit_p": float(chi2.sf(stat, dof))}

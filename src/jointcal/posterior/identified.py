@@ -118,7 +118,8 @@ def quantities(q: ArrayLike, *, m: float, model: str = "harmonic_balance", visco
 
 def identified_table(samples: ArrayLike, names: Sequence[str], space: ParamSpace, q: ArrayLike, f: ArrayLike,
                      zeta: ArrayLike, *, m: float, model: str = "harmonic_balance", viscous: str = "dashpot",
-                     ratio: float = 0.5, why_not: str = "") -> tuple[pd.DataFrame, NDArray[np.float64]]:
+                     ratio: float = 0.5, why_not: str = "",
+                     weight: ArrayLike | None = None) -> tuple[pd.DataFrame, NDArray[np.float64]]:
     """Every candidate quantity with its 90% interval and whether the data identify it.
 
     Parameters
@@ -144,6 +145,8 @@ def identified_table(samples: ArrayLike, names: Sequence[str], space: ParamSpace
         reports none of them identified (the curves at the measured amplitudes, fixed by the
         read-outs themselves, still are). ``identified`` stays the local information's
         judgement, which the design stage reads to choose what the next test must fix.
+    weight : array_like, shape (N,), optional
+        The read-outs' weights in the likelihood (`jointcal.calibrate.ModalData.weight`); default 1.
 
     Returns
     -------
@@ -158,7 +161,7 @@ def identified_table(samples: ArrayLike, names: Sequence[str], space: ParamSpace
     S = np.asarray(samples, dtype=float)
     theta = S[:, [col[p] for p in space.names]]
     sigma = S[:, [col["sigma_f"], col["sigma_zeta"]]]
-    info = fisher(theta, sigma, q, f, zeta, space, m=m, model=model, viscous=viscous)
+    info = fisher(theta, sigma, q, f, zeta, space, m=m, model=model, viscous=viscous, weight=weight)
     n_fixed = float(np.median(fixed_directions(info, ratio)))
     u = space.to_unit(theta)
     cov = np.cov(u, rowvar=False)
@@ -292,20 +295,20 @@ def settled(table: pd.DataFrame) -> pd.DataFrame:
 
 def write_identified(modal_csv: str | os.PathLike[str], ga_best_json: str | os.PathLike[str],
                    chain_npz: str | os.PathLike[str], assembly: str, cal: CalibrateSettings, ps: PosteriorSettings,
-                   out_csv: str | os.PathLike[str]) -> str:
+                   out_csv: str | os.PathLike[str], backbone_csv: str | os.PathLike[str] | None = None) -> str:
     """Write ``identified.csv``, the posterior stage's last output, from the chain it wrote (`identified_table`).
 
     Which parameters and combinations the data identify, from the draws in `chain_npz`, with the
     reason when the chain has not settled (`unsettled`). Returns a line for the log.
     """
     cal = cal.resolved(json.loads(Path(ga_best_json).read_text()))
-    data = read_modal(modal_csv, assembly, damping=cal.damping)
+    data = read_modal(modal_csv, assembly, damping=cal.damping, backbone_csv=backbone_csv)
     with np.load(chain_npz) as z:
         names = [str(n) for n in z["sample_names"]]
         why_not = unsettled({k: z[k] for k in z.files}, names, tau_factor=ps.tau_factor)
         table, _ = identified_table(z["samples"], names, cal.space, data.q, data.f, data.zeta, m=cal.m,
                                     model=cal.model, viscous=cal.viscous, ratio=ps.constrained_ratio,
-                                    why_not=why_not)
+                                    why_not=why_not, weight=data.weight)
     write_csv_atomic(table, out_csv)
     return ("identified: " + ", ".join(table.loc[table["identified"], "quantity"]) + "; left to the bounds: "
             + ", ".join(table.loc[~table["identified"], "quantity"]) + (f" ({why_not})" if why_not else ""))

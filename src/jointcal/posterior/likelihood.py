@@ -12,7 +12,9 @@ modal read-outs see the joint only, so a grown column is left to its prior here.
 Likelihood: independent Gaussians on the relative residuals,
 r_f,i = (f_i - f~(q_i))/f_i ~ N(0, sigma_f^2) and r_z,i = (zeta_i - zeta~(q_i))/zeta_i
 ~ N(0, sigma_zeta^2), with the model and viscous convention of the GA. Unlike eq. 3.9
-there is no weight eta: each residual counts by its noise.
+there is no weight eta: each residual counts by its noise. A point of weight w_i (a ring-down's
+k windows, 1/k each: `jointcal.calibrate._readouts`) enters with its Gaussian raised to w_i, so
+that a ring-down counts as one read-out, as in the GA; with one point per run every w_i is 1.
 
 The noise scales are sampled, not fixed. Their priors are log-uniform from the pooled
 repeat scatter of the modal stage (floored, `ModalData.rel_noise`) up to ``noise_max``:
@@ -161,6 +163,9 @@ class LogPosterior:
         r_f, r_z = self.residuals(x[ok])
         s_f, s_z = 10.0 ** x[ok, -2], 10.0 ** x[ok, -1]
         n = self.data.q.size
+        if self.data.weight is not None:  # each point's Gaussian to the power of its weight
+            w, n = self.data.w, self.data.n_readouts
+            r_f, r_z = r_f * np.sqrt(w), r_z * np.sqrt(w)
         with np.errstate(all="ignore"):
             lp = (-0.5 * np.sum(r_f**2, axis=1) / s_f**2 - n * np.log(s_f)
                   - 0.5 * np.sum(r_z**2, axis=1) / s_z**2 - n * np.log(s_z)

@@ -10,7 +10,11 @@ them (a quadratic in log q of log f and of log zeta, fitted by least squares): w
 varies from run to run faster than any backbone can. It errs high where the measured
 backbone has more shape than a quadratic (a smaller chi-square, never a false rejection
 from a floor). `noise_scale` applies it per quantity where the scatter table has no
-degrees of freedom.
+degrees of freedom. A run read at many points (a ring-down's windows) is its own smooth curve:
+its points' scatter about a cubic in log q over its own amplitudes, pooled with the other runs'
+scatter about one quadratic across them (a quadratic through four ring-downs over three decades
+of the virtual Ministack left 0.23% in f; each ring-down's own cubic 0.01-0.04%, its windows'
+read-out noise).
 
 `data_problem` names what in the read-outs stops a posterior (two modes mixed in one
 assembly, too few levels, a flat backbone) and the fix, in one sentence.
@@ -73,6 +77,26 @@ def readout_noise(q: ArrayLike, f: ArrayLike, zeta: ArrayLike, *, degree: int = 
     return out[0], out[1], n - degree - 1
 
 
+def _own_scatter(data: ModalData) -> tuple[float, float, int]:
+    """`readout_noise` of the data; with runs of many points, each such run about its own cubic and the
+    single read-outs about one quadratic, pooled over their degrees of freedom."""
+    if data.weight is None:
+        return readout_noise(data.q, data.f, data.zeta)
+    ids = np.asarray(data.run_id, dtype=object)
+    names, counts = np.unique(ids, return_counts=True)
+    groups = [ids == r for r in names[counts > 1]] + [np.isin(ids, names[counts == 1])]
+    ss, dof = np.zeros(2), 0
+    for g, degree in zip(groups, [3] * (len(groups) - 1) + [2]):
+        s_f, s_z, d = readout_noise(data.q[g], data.f[g], data.zeta[g], degree=degree)
+        if d > 0:
+            ss += d * np.array([s_f, s_z]) ** 2
+            dof += d
+    if dof == 0:
+        return float("nan"), float("nan"), 0
+    s_f, s_z = np.sqrt(ss / dof)
+    return float(s_f), float(s_z), dof
+
+
 def _dof(scatter: pd.DataFrame | None, assembly: str, quantity: str) -> int:
     if scatter is None or "n" not in scatter.columns:
         return 0
@@ -103,7 +127,7 @@ def noise_scale(data: ModalData, scatter: pd.DataFrame | None,
         'repeats', 'own' or 'floor', for frequency and damping (`SOURCE_WORDS`).
     notes : list of str
     """
-    own_f, own_z, dof = readout_noise(data.q, data.f, data.zeta)
+    own_f, own_z, dof = _own_scatter(data)
     noise, sources, notes = list(data.rel_noise), [], []
     for i, (qty, key, own) in enumerate(((FREQUENCY, "frequency", own_f), (data.damping, "damping", own_z))):
         if _dof(scatter, data.assembly, qty) > 0:

@@ -73,12 +73,13 @@ def _npz(arrays: dict) -> bytes:
     return buf.getvalue()
 
 
-def _read(modal_csv, scatter_csv, ga_best_json, assembly: str, cal: CalibrateSettings,
-          ps: PosteriorSettings) -> tuple[ModalData, dict, CalibrateSettings, np.ndarray, list[str], tuple[str, str]]:
+def _read(modal_csv, scatter_csv, ga_best_json, assembly: str, cal: CalibrateSettings, ps: PosteriorSettings,
+          backbone_csv=None) -> tuple[ModalData, dict, CalibrateSettings, np.ndarray, list[str], tuple[str, str]]:
     """Step 1, read: the assembly's modal data with its noise scales (`noise_scale`), the calibration's
-    optimum and the settings it was made with."""
+    optimum and the settings it was made with (with backbone.csv: a ring-down's windows and a level's
+    dwells' phase resonance, each read-out weighted once, as the calibration read them)."""
     data = read_modal(modal_csv, assembly, scatter_csv=scatter_csv, damping=cal.damping,  # type: ignore[arg-type]
-                      floors=dict(ps.rel_std_floor))
+                      floors=dict(ps.rel_std_floor), backbone_csv=backbone_csv)
     data, sources, own = noise_scale(data, read_table(scatter_csv), dict(ps.rel_std_floor))
     best = json.loads(Path(ga_best_json).read_text())
     cal = cal.resolved(best)  # the model kind, mass and bounds the calibration used
@@ -89,8 +90,8 @@ def _read(modal_csv, scatter_csv, ga_best_json, assembly: str, cal: CalibrateSet
     return data, best, cal, cal.space.vector(best), [*data.notes, *own], sources
 
 
-def posterior_of(modal_csv, scatter_csv, ga_best_json, assembly: str, cal: CalibrateSettings, ps: PosteriorSettings
-                 ) -> tuple[LogPosterior, dict, CalibrateSettings, np.ndarray, list[str], tuple[str, str]]:
+def posterior_of(modal_csv, scatter_csv, ga_best_json, assembly: str, cal: CalibrateSettings, ps: PosteriorSettings,
+                 backbone_csv=None) -> tuple[LogPosterior, dict, CalibrateSettings, np.ndarray, list[str], tuple[str, str]]:
     """The log-posterior the chain samples, without sampling: read (`_read`), stop on what in the data makes it
     meaningless (`data_problem`: two modes, noise above noise_max), and build it. `fit_test` of it at the
     returned optimum is the chi-square the verdict shows.
@@ -101,7 +102,8 @@ def posterior_of(modal_csv, scatter_csv, ga_best_json, assembly: str, cal: Calib
         The LogPosterior, ga_best.json, the resolved settings, the optimum, notes for the log and the
         noise scales' sources.
     """
-    data, best, cal, theta, notes, sources = _read(modal_csv, scatter_csv, ga_best_json, assembly, cal, ps)
+    data, best, cal, theta, notes, sources = _read(modal_csv, scatter_csv, ga_best_json, assembly, cal, ps,
+                                                   backbone_csv)
     noise_max = (ps.noise_max["frequency"], ps.noise_max["damping"])
     problems = data_problem(data, noise_max=noise_max, where=str(modal_csv))
     stop = [text for kind, text in problems if kind in ("two_modes", "noise")]
@@ -117,7 +119,7 @@ def _fingerprint(data: ModalData, theta: np.ndarray, cal: CalibrateSettings, ps:
                  noise_max=(ps.noise_max["frequency"], ps.noise_max["damping"]),
                  cal=[cal.model, cal.viscous, cal.damping, cal.m, cal.full_bounds])
     fp = hashlib.sha256(json.dumps(shape, sort_keys=True).encode())
-    for a in (data.q, data.f, data.zeta):
+    for a in (data.q, data.f, data.zeta) + (() if data.weight is None else (data.w,)):
         fp.update(a.tobytes())
     return fp.hexdigest()
 
@@ -190,7 +192,8 @@ def run_posterior(modal_csv: str | os.PathLike[str], scatter_csv: str | os.PathL
                   ga_best_json: str | os.PathLike[str], assembly: str, out_dir: str | os.PathLike[str],
                   cal: CalibrateSettings, ps: PosteriorSettings, *,
                   checkpoint: str | os.PathLike[str] | None = None,
-                  progress: Callable[[str], None] | None = None) -> tuple[ChainResult, list[str]]:
+                  progress: Callable[[str], None] | None = None,
+                  backbone_csv: str | os.PathLike[str] | None = None) -> tuple[ChainResult, list[str]]:
     """Sample one assembly's posterior and write the stage's outputs: read, decide where to start, sample, write.
 
     Parameters
@@ -208,6 +211,8 @@ def run_posterior(modal_csv: str | os.PathLike[str], scatter_csv: str | os.PathL
     progress : callable, optional
         Receives one line (steps so far, largest running autocorrelation time, chain
         length in units of it) after every chunk, for the stage's log.
+    backbone_csv : path-like, optional
+        The unit's ``backbone.csv``, as the calibration read it (`jointcal.calibrate.read_modal`).
 
     Returns
     -------
@@ -215,7 +220,8 @@ def run_posterior(modal_csv: str | os.PathLike[str], scatter_csv: str | os.PathL
     notes : list of str
         Lines for the log (floors used, resume, convergence).
     """
-    lp, best, cal, theta, notes, sources = posterior_of(modal_csv, scatter_csv, ga_best_json, assembly, cal, ps)
+    lp, best, cal, theta, notes, sources = posterior_of(modal_csv, scatter_csv, ga_best_json, assembly, cal, ps,
+                                                        backbone_csv)
     data = lp.data
     fingerprint = _fingerprint(data, theta, cal, ps)
     ckpt = None if checkpoint is None else Path(checkpoint)

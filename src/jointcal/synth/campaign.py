@@ -178,6 +178,8 @@ def generate(spec: dict | str | os.PathLike, out_dir: str | os.PathLike, truth_p
         truth_rows.append(dict(run_id=row.run_id, assembly=row.assembly, sequence=row.sequence,
                                **lev, direction=row.direction, **ranges, **extra))
     manifest = plan.drop(columns=[c for c in STEADY_PRIVATE if c in plan])
+    if "dwell_hz" in manifest and manifest["dwell_hz"].isna().all():  # ring-downs only: no empty last column
+        manifest = manifest.drop(columns=["dwell_hz"])
     write_csv_atomic(manifest.drop(columns=["level_V"]) if ref == "force" else manifest, out_dir / "manifest.csv")
     table = pd.DataFrame(truth_rows)
     write_json_atomic(dict(spec=spec, effect=dict(name=effect, params=eparams),
