@@ -19,6 +19,7 @@
 """
 from __future__ import annotations
 
+import json
 import time
 from dataclasses import replace
 from collections.abc import Callable, Mapping, Sequence
@@ -43,7 +44,7 @@ from .settings import DiscrepancySettings
 from .select import score_candidates
 from .words import diagnosis_markdown
 
-__all__ = ["DiscrepancySettings", "diagnose", "diagnosis_markdown", "valley_starts"]
+__all__ = ["DiscrepancySettings", "diagnose", "diagnosis_markdown", "valley_starts", "run_discrepancy"]
 
 
 def valley_starts(history: pd.DataFrame, best: Mapping, *, n: int = 3, rel: float = np.inf) -> list[list[float]]:
@@ -280,3 +281,47 @@ def _recalibrated_json(final, cf, rec, n_fits) -> dict:
                        + ("" if rec.converged else " (short of 50 tau: intervals approximate)")
                        + "; intervals are the 5-95% posterior quantiles"),
             "posterior_converged": rec.converged}
+
+
+def run_discrepancy(assembly: str, *, runs_csv, modal_csv, envelope_files: Sequence[str], record_files: Sequence[str],
+                    best_json, history_csv, validation_json, out: Mapping[str, str], config: Mapping[str, Mapping],
+                    executor=None, log: Callable[[str], None] | None = None) -> dict:
+    """The stage for one (assembly, mode), from the files the workflow has to the files it writes.
+
+    Reads runs.csv, this unit's modal_properties.csv, the runs' envelopes and records, the
+    calibration (ga_best.json, ga_history.csv) and the validation (summary.json and its
+    envelopes/ beside it); `diagnose`s; writes ``out``'s diagnosis (json), markdown, residuals,
+    metrics_after, residual_figure and before_after_figure. ``config`` holds the config's
+    discrepancy, calibrate, validate, envelopes and modal sections. Returns the diagnosis.
+    """
+    from pathlib import Path
+
+    from ..calibrate import CalibrateSettings
+    from ..io import listed_record, read_run, write_bytes_atomic, write_csv_atomic, write_json_atomic
+    from ..report.discrepancy import before_after_figure, residual_map_figure
+
+    runs = pd.read_csv(runs_csv, dtype={"flags": str})
+    modal = pd.read_csv(modal_csv, dtype={"flags": str})  # this (assembly, mode)'s rows
+    rows = runs[runs["run_id"].isin(modal["run_id"])].to_dict("records")
+    env_dir = Path(envelope_files[0]).parent
+    envs = {r["run_id"]: pd.read_csv(env_dir / f"{r['run_id']}.csv") for r in rows
+            if (env_dir / f"{r['run_id']}.csv").is_file()}
+    records = [read_run(listed_record(str(r["file"]), list(record_files)), r) for r in rows]
+    best = json.loads(Path(best_json).read_text())
+    summary = json.loads(Path(validation_json).read_text())
+    space = CalibrateSettings.from_config(config.get("calibrate")).resolved(best).space
+    before = {p.stem: pd.read_csv(p) for p in (Path(validation_json).parent / "envelopes").glob("*.csv")}
+    res = diagnose(assembly, envs, modal, best, summary.get("scale"), records, rows, space=space,
+                   settings=DiscrepancySettings.from_config(config.get("discrepancy")),
+                   validate_settings=ValidateSettings.from_config(config.get("validate")),
+                   envelopes_kw=dict(config["envelopes"]), modal_kw=dict(config["modal"]),
+                   metric_before=float(summary["E"]), frames_before=before,
+                   joint_starts=valley_starts(pd.read_csv(history_csv), best), executor=executor, log=log)
+    d = res["diagnosis"]
+    write_csv_atomic(res["residuals"], out["residuals"])
+    write_csv_atomic(res["validation_after"].metrics, out["metrics_after"])
+    write_bytes_atomic(diagnosis_markdown(d).encode(), out["markdown"])
+    residual_map_figure(res["residuals"], d, Path(out["residual_figure"]))
+    before_after_figure(before, res["validation_after"].frames, d, Path(out["before_after_figure"]))
+    write_json_atomic(d, out["diagnosis"])
+    return d
