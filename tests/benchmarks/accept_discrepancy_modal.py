@@ -14,7 +14,28 @@ effect named, confidence, E before and after, the stage's time.
 
 Acceptance (issue 30): each effect named with confidence high in >= 5 of 6 campaigns and E falling
 by >= 70%; 'none' 6 of 6; contact_spring 'unexplained'; elastic_softening + cubic_stiffening both
-named in >= 2 of 3 seeds.
+named in >= 2 of 3 seeds. NOT MET. Measured 2026-11-26, seed 1 only, on a loaded 2-core machine
+(hidden effect, rig: named, confidence, time-domain E before -> after, the fast model's floor E):
+
+    none                                 force    seed 1: none                                 medium E   0.59 ->  1.74 (+195%)  floor 4.16, stage 28 s
+    none                                 voltage  seed 1: unexplained                          low    E   1.20 ->  1.04 ( -13%)  floor 0.16, stage 35 s
+    elastic_softening                    force    seed 1: unexplained                          low    E   8.87 ->  4.08 ( -54%)  floor 6.21, stage 110 s
+    elastic_softening                    voltage  seed 1: unexplained                          low    E   5.30 ->  0.97 ( -82%)  floor 0.17, stage 74 s
+    cubic_stiffening                     force    seed 1: cubic_stiffening                     medium E  10.53 ->  0.63 ( -94%)  floor 1.67, stage 90 s
+    cubic_stiffening                     voltage  seed 1: unexplained                          low    E   5.30 ->  1.50 ( -72%)  floor 0.17, stage 92 s
+    neighbour_mode                       force    seed 1: neighbour_mode                       medium E 110.88 ->  6.31 ( -94%)  floor 3.85, stage 109 s
+    neighbour_mode                       voltage  seed 1: neighbour_mode                       medium E  91.42 ->  3.39 ( -96%)  floor 0.10, stage 110 s
+    joint_settling                       force    seed 1: unexplained                          low    E   5.40 ->  3.51 ( -35%)  floor 4.06, stage 64 s
+    joint_settling                       voltage  seed 1: unexplained                          low    E   3.72 ->  1.45 ( -61%)  floor 0.16, stage 39 s
+    channel_delay                        force    seed 1: unexplained                          low    E  50.00 -> 45.16 ( -10%)  floor 2.60, stage 143 s
+    channel_delay                        voltage  seed 1: unexplained                          low    E   3.52 ->  2.91 ( -17%)  floor 0.16, stage 63 s
+    elastic_softening+cubic_stiffening   force    seed 1: cubic_stiffening                     medium E   9.38 ->  0.94 ( -90%)  floor 1.86, stage 40 s
+    elastic_softening+cubic_stiffening   voltage  seed 1: unexplained                          low    E   6.03 ->  1.68 ( -72%)  floor 0.19, stage 42 s
+    contact_spring                       force    seed 1: unexplained                          low    E  22.18 -> 11.29 ( -49%)  floor 1.04, stage 42 s
+    contact_spring                       voltage  seed 1: unexplained                          low    E  14.91 ->  4.59 ( -69%)  floor 0.22, stage 60 s
+
+The force rig's floor (E 3-8 on its eta-2 runs) is the open-loop force's dip at resonance: five-fold within a few
+cycles, its phase turning with it, which the fast model's frame-by-frame drive magnitude does not follow.
 """
 import argparse
 import json
