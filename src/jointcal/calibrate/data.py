@@ -28,6 +28,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from jointcal.io import UNUSABLE_FLAGS, level_column
+from jointcal.io.contract import UNUSABLE
 
 from ._readouts import expand
 
@@ -100,7 +101,7 @@ class ModalData:
 def _usable(flags: pd.Series) -> NDArray[np.bool_]:
     """False for runs flagged unusable or with an ingest flag in UNUSABLE_FLAGS (units, level, channels, clipping)."""
     text = flags.map(lambda v: "" if pd.isna(v) else str(v))
-    return ~text.map(lambda t: any("unusable" in tok.strip().lower()
+    return ~text.map(lambda t: any(UNUSABLE in tok.strip().lower()
                                    or tok.strip().split(":")[0] in UNUSABLE_FLAGS for tok in t.split(";"))
                      ).to_numpy(bool)
 

@@ -64,7 +64,7 @@ from .envelope import (  # envelope's public batch API, under this module's shor
     GAUSS_NODES as _NODES, GAUSS_WEIGHTS as _WEIGHTS, batch_field as _field, batch_shape as _batch_shape,
     joint_terms as _joint_terms, sweep_amplitudes as _amplitudes,
 )
-from .structure import MinistackModel, Neighbour
+from .structure import MinistackModel, Neighbour, can_spring
 
 __all__ = ["SweepDrive", "quasi_steady", "quasi_steady_runs", "sweep_eta", "CAP"]
 
@@ -124,8 +124,7 @@ def _derivs(model: MinistackModel, w: NDArray, shape) -> tuple[NDArray, ...]:
         return (*out, z, z)
     fx = model.fixture
     mc = _field(fx.m_can, shape)[:, None]
-    kc0 = mc * (2 * np.pi * _field(fx.f_can, shape)[:, None]) ** 2
-    cc = 2.0 * _field(fx.zeta_can, shape)[:, None] * np.sqrt(kc0 * mc)
+    kc0, cc = can_spring(mc, _field(fx.f_can, shape)[:, None], _field(fx.zeta_can, shape)[:, None])
     w2, w3, w4, m2 = w**2, w**3, w**4, m**2  # powers taken once (the same values as inline)
     kc, kc1 = kc0 + 1j * w * cc, 1j * cc + z
     a, a1, a2 = kc - w2 * (mc + m), kc1 - 2 * w * (mc + m), -2 * (mc + m) + z
