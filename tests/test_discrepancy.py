@@ -17,7 +17,7 @@ from jointcal.calibrate import CalibrateSettings, run_calibration
 from jointcal.calibrate.space import PARAMS
 from jointcal.discrepancy import EFFECTS, DiscrepancySettings, decide, diagnose, diagnosis_markdown, score_candidates
 from jointcal.discrepancy.data import RunEnvelope
-from jointcal.discrepancy.fit import candidate, envelope_E, model_at, predict
+from jointcal.discrepancy.fit import Objective, candidate, model_at
 from jointcal.discrepancy.rule import NONE_E, confirm
 from jointcal.discrepancy.rule import needs_pairs, pair_names
 from jointcal.discrepancy.select import Scored
@@ -44,7 +44,7 @@ def _runs(effect="baseline", values=(), noise=(0.05, 0.3), seed=0, rate=0.0):
                        zeta_phase_resonance=0.02)
             probe = RunEnvelope(f, np.full(f.size, level), np.ones(f.size, complex), np.full(f.size, noise[0]),
                                 np.full(f.size, noise[1]), rate if direction == "up" else -rate, row)
-            T = predict(c, theta, probe)
+            T = Objective(c, [probe]).predict(theta, 0)
             T = T * 10 ** (rng.normal(0, noise[0], f.size) / 20) * np.exp(1j * np.radians(rng.normal(0, noise[1], f.size)))
             runs.append(RunEnvelope(f, probe.base_g, T, probe.sigma_db, probe.sigma_deg, probe.rate, row))
     return runs
@@ -80,7 +80,7 @@ def test_a_new_library_effect_grows_the_space_and_is_fitted_without_other_change
 
 def test_E_of_the_truth_is_about_one_on_noise_at_the_scatter():
     runs = _runs()
-    E = envelope_E(candidate("baseline", SPACE, M), TRUTH, runs)
+    E = Objective(candidate("baseline", SPACE, M), runs).E(TRUTH)
     assert 0.8 < E < 1.2  # noise of exactly the scatter: E = 1 within its sampling spread (1280 frames)
 
 

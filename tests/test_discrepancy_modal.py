@@ -116,7 +116,7 @@ def test_each_modal_effect_hidden_in_a_force_campaign_is_named_by_the_rule(hidde
     the baseline's."""
     from jointcal.calibrate.space import PARAMS, ParamSpace
     from jointcal.calibrate.kind import data_bounds
-    from jointcal.discrepancy.fit import candidate, envelope_E, with_transient
+    from jointcal.discrepancy.fit import Objective, candidate
     from jointcal.discrepancy.rule import CLOSE_FRACTION, decide
     from jointcal.discrepancy.select import score_candidates
 
@@ -140,7 +140,7 @@ def test_each_modal_effect_hidden_in_a_force_campaign_is_named_by_the_rule(hidde
         # start: the stage's GA over the grown space goes further) closes the rule's fraction of that gap
         c = candidate(hidden, space, BEAM.m, scales)
         th = c.grown.vector({**dict(zip(PARAMS, theta0)), **values})
-        E_truth = envelope_E(c, th, with_transient(c, th, runs))
+        E_truth = Objective(c, runs).at(th).E(th)
         named = next(s for s in scored if s.name == hidden)
         print(f"E: truth {E_truth:.2f}, named fit {named.fit.E:.2f}, baseline fit {base.fit.E:.2f}")
         assert base.fit.E >= 1.5 * E_truth

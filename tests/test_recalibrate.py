@@ -14,7 +14,7 @@ import pytest
 from jointcal.calibrate import CalibrateSettings
 from jointcal.calibrate.space import PARAMS
 from jointcal.discrepancy.data import run_envelope, scale_arrays
-from jointcal.discrepancy.fit import HELD, candidate, fit_candidate
+from jointcal.discrepancy.fit import HELD, Objective, candidate
 from jointcal.discrepancy.recalibrate import recalibrate
 from jointcal.models import G
 from jointcal.posterior import LogPosterior
@@ -75,7 +75,7 @@ def test_the_posterior_of_joint_plus_sensor_gain_covers_the_truth(tmp_path):
     assert c.grown.names == (*PARAMS, "gain")
     start = {**TRUTH, "Fs": 1.1 * TRUTH["Fs"], "KT": 0.95 * TRUTH["KT"], "k": 1.05 * TRUTH["k"],
              "zeta_v": 1.2 * TRUTH["zeta_v"]}  # a calibration slightly off, as the joint's calibration gives
-    fit = fit_candidate(c, runs, SPACE.vector(start), starts=3, max_nfev=25, refresh=1)
+    fit = Objective(c, runs).fit(SPACE.vector(start), starts=3, max_nfev=25, refresh=1)
     rec = recalibrate(c, runs, [fit], generations=3, population=24, walkers=24, steps=300, max_nfev=25)
     q = rec.quantiles
     print("\n" + q.assign(truth=[*[TRUTH[p] for p in PARAMS], GAIN]).to_string(), f"\nE {rec.fit.E:.2f}")

@@ -44,9 +44,8 @@ class RunEnvelope:
     sigma_db, sigma_deg : repeat scatter of magnitude and phase at each frame; rate : signed
     sweep rate df/dt, Hz/s; row : the manifest/modal row (run_id, its level, direction,
     sequence, f_res_hz, zeta_phase_resonance, ...); t_s : frame times, s; drive : the run's
-    measured drive (None: frames taken as a constant-rate sweep, no transient integrated);
-    transient : the sweep transient's factor on the first-order envelope at the frames
-    (`fit.with_transient`; None: 1).
+    measured drive (None: frames taken as a constant-rate sweep, no transient integrated).
+    Measurements only: the model's sweep-transient factor belongs to the objective (`fit.Objective`).
     """
 
     f_hz: NDArray[np.float64]
@@ -58,7 +57,6 @@ class RunEnvelope:
     row: dict
     t_s: NDArray[np.float64] | None = None
     drive: SweepDrive | None = None
-    transient: NDArray[np.complex128] | None = None
     level: float = float("nan")
     equivalent_base: NDArray[np.complex128] | None = None
 

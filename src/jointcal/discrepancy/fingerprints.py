@@ -1,7 +1,7 @@
 """Where measurement and model disagree: residual maps and the fingerprint features of each effect.
 
 Residuals are the measured transmissibility over the baseline model's (the swept fast
-model, `fit.predict`), in dB and degrees, divided by the repeat scatter of
+model, `fit.Objective.predict`), in dB and degrees, divided by the repeat scatter of
 their bin. Fingerprints (each effect's test of them is its module's ``fingerprint``,
 `jointcal.effects`):
 
@@ -26,26 +26,26 @@ masing_ratio                measured (zeta - zeta_v)/(1 - f/f0) at the lowest le
 """
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
 
 from ..effects import EFFECTS
 from ..io import level_column
-from .data import RunEnvelope
-from .fit import Candidate, predict
+from .fit import Objective
 
 __all__ = ["residual_map", "fingerprints", "verdicts", "outside_library", "EVEN_HARMONIC"]
 
 EVEN_HARMONIC = 0.01  # 2nd harmonic over the fundamental at the top level above which parity counts
 
 
-def residual_map(c: Candidate, theta, runs: Sequence[RunEnvelope]) -> pd.DataFrame:
-    """Tidy residuals of one model: run_id, level, direction, sequence, f_hz, x, d_mag_db, d_phase_deg, z_mag, z_phase."""
+def residual_map(obj: Objective, theta) -> pd.DataFrame:
+    """Tidy residuals of one model on its objective's runs: run_id, level, direction, sequence, f_hz, x, d_mag_db,
+    d_phase_deg, z_mag, z_phase."""
     rows = []
-    for run in runs:
-        d = run.T / predict(c, theta, run)  # measured over model
+    for i, run in enumerate(obj.runs):
+        d = run.T / obj.predict(theta, i)  # measured over model
         r = run.row
         f_res = float(r["f_res_hz"])
         rows.append(pd.DataFrame(dict(

@@ -7,8 +7,10 @@ every run weighted equally; E^2 = (E_mag^2 + E_phase^2) / 2. The model's envelop
 one a sweep shows (`jointcal.models.swept`): the first-order quasi-steady envelope at
 each frame (`quasi_steady`, cheap and batched over parameter sets) times the run's
 transient factor, the slow flow integrated through the resonance over the first-order
-envelope, both at a reference parameter set (`with_transient`). A fit refreshes the factor
-at its optimum and refits from there (`fit_candidate(refresh=...)`): the factor changes
+envelope, both at a reference parameter set (`transient_factor`). One `Objective` (a candidate on
+one assembly's runs, linearised at a parameter set) owns the residuals, E, the prediction and
+the fit; a fit retakes the factor at its optimum and refits from there (`Objective.fit(refresh=...)`,
+the factor retaken in one place, `Objective.at`): the factor changes
 little with the parameters, and at convergence the fitted envelope is the integrated one.
 So the fits do not mistake the sweep's lag, lower peak or ringing for an effect.
 
@@ -36,8 +38,8 @@ from ..models.swept import quasi_steady_runs
 from .data import RunEnvelope, run_zeta
 from ..effects import EFFECTS, apply_effect, effects_of
 
-__all__ = ["HELD", "Candidate", "Fit", "candidate", "structure_scales", "model_at", "fit_candidate", "envelope_E", "observed", "predict",
-           "with_transient"]
+__all__ = ["HELD", "Candidate", "Fit", "Objective", "candidate", "structure_scales", "model_at", "observed",
+           "transient_factor"]
 
 HELD = ("beta",)  # joint parameters the envelopes barely constrain: held at the start's value by every fit
 
@@ -121,11 +123,6 @@ def _first_order_runs(c: Candidate, theta: NDArray, runs: Sequence[RunEnvelope])
     return quasi_steady_runs(model_at(c, theta, runs[0].row), [_drive(run) for run in runs])
 
 
-def _first_order(c: Candidate, theta: NDArray, run: RunEnvelope) -> NDArray[np.complex128]:
-    """The first-order quasi-steady envelope at the run's frames, (P, n) or (n,)."""
-    return _first_order_runs(c, theta, [run])[0]
-
-
 def observed(model: MinistackModel, T: NDArray, run: RunEnvelope) -> NDArray[np.complex128]:
     """What the run's response over reference reads of the model's base-rig envelope T, (P, n) or (n,).
 
@@ -140,52 +137,26 @@ def observed(model: MinistackModel, T: NDArray, run: RunEnvelope) -> NDArray[np.
     return run.equivalent_base * (T - gain * np.exp(-2j * np.pi * run.f_hz * tau))
 
 
-def predict(c: Candidate, theta: NDArray, run: RunEnvelope) -> NDArray[np.complex128]:
-    """The run's measured quantity as the model gives it at its frames as the sweep shows it, (P, n) or (n,):
-    the first-order envelope times the run's transient factor (see the module notes), `observed`."""
-    T = _first_order(c, theta, run)
-    T = T if run.transient is None else T * run.transient
-    return observed(model_at(c, theta, run.row), T, run)
-
-
-def with_transient(c: Candidate, theta: NDArray, runs: Sequence[RunEnvelope]) -> list[RunEnvelope]:
-    """The runs with their transient factor at parameters theta (n,): the integrated swept envelope
-    (`swept_transmissibility`) over the first-order one at each frame (1 where nothing is integrated)."""
-    out = []
-    for run in runs:
-        if run.drive is None or run.t_s is None:
-            out.append(replace(run, transient=None))
-            continue
-        model = model_at(c, theta, run.row)
-        zeta = run_zeta(run.row)
-        swept = swept_transmissibility(model, run.drive, run.t_s, f_res_hz=float(run.row["f_res_hz"]), zeta=zeta)
-        with np.errstate(all="ignore"):
-            factor = swept / _first_order(c, theta, run)
-        out.append(replace(run, transient=np.where(np.isfinite(factor), factor, 1.0)))
-    return out
+def transient_factor(c: Candidate, theta: NDArray, run: RunEnvelope) -> NDArray[np.complex128] | None:
+    """The run's sweep-transient factor at parameters theta (n,): the integrated swept envelope
+    (`swept_transmissibility`) over the first-order one at each frame (None where nothing is integrated:
+    a run without its drive)."""
+    if run.drive is None or run.t_s is None:
+        return None
+    model = model_at(c, theta, run.row)
+    swept = swept_transmissibility(model, run.drive, run.t_s, f_res_hz=float(run.row["f_res_hz"]), zeta=run_zeta(run.row))
+    with np.errstate(all="ignore"):
+        factor = swept / _first_order_runs(c, theta, [run])[0]
+    return np.where(np.isfinite(factor), factor, 1.0)
 
 
 def _run_residual(model: MinistackModel, T: NDArray, run: RunEnvelope, n_runs: int) -> NDArray:
-    """Weighted magnitude (dB) and phase (deg) errors of first-order envelope T at the run's frames."""
-    d = observed(model, T if run.transient is None else T * run.transient, run) / run.T
+    """Weighted magnitude (dB) and phase (deg) errors of the envelope T (transient included) at the run's frames."""
+    d = observed(model, T, run) / run.T
     w = 1.0 / np.sqrt(2.0 * run.f_hz.size * n_runs)
     dm = 20 * np.log10(np.abs(d)) / run.sigma_db
     dp = np.degrees(np.angle(d)) / run.sigma_deg
     return np.concatenate([dm, dp], axis=-1) * w
-
-
-def residuals(c: Candidate, theta: NDArray, runs: Sequence[RunEnvelope]) -> NDArray:
-    """Residual vector whose sum of squares is E^2 (theta (n,) -> (m,), (P, n) -> (P, m))."""
-    with np.errstate(all="ignore"):
-        T = _first_order_runs(c, theta, runs)
-        model = model_at(c, theta, runs[0].row)  # its sensor (no effect changes it along the sequence)
-        r = np.concatenate([_run_residual(model, t, run, len(runs)) for t, run in zip(T, runs)], axis=-1)
-    return np.where(np.isfinite(r), r, 1e3)
-
-
-def envelope_E(c: Candidate, theta: NDArray, runs: Sequence[RunEnvelope]) -> float:
-    """E of the fast model at theta over `runs` (the validation's definition, steady state + lag)."""
-    return float(np.sqrt(np.sum(residuals(c, theta, runs) ** 2)))
 
 
 @dataclass(frozen=True)
@@ -199,28 +170,96 @@ class Fit:
     n_eval: int
 
 
-def fit_candidate(c: Candidate, runs: Sequence[RunEnvelope], theta0: NDArray, *, starts: int = 3,
-                  max_nfev: int = 60, free_joint: bool = True, refresh: int = 0) -> Fit:
-    """Bounded least squares of E^2 over the candidate's unit cube, from theta0 and effect start values.
+@dataclass(frozen=True)
+class Objective:
+    """A candidate on one assembly's runs, linearised at theta_ref: E, its residuals, the prediction, the fit.
 
-    theta0 : (6,) or (n,) physical start, in the candidate's column order (the joint's parameters
-    alone, or with effect values; the effect values it does not give default to their `start`).
-    starts : effect starts tried (the `start` value and evenly spread points of the unit interval,
-    for the effect parameters theta0 does not give). free_joint : False holds the joint parameters.
-    refresh : times the runs' transient factor is recomputed (at theta0 first, then at each
-    optimum, refitting from it); 0 keeps the runs' own factor.
+    The model's envelope is the first-order quasi-steady one at each frame (cheap, batched over
+    parameter sets) times each run's sweep-transient factor taken at theta_ref (`transient_factor`:
+    the slow flow integrated through the resonance over the first-order envelope). The runs hold
+    measurements only; the factor is the objective's, refreshed in one place (`at`).
+
+    Attributes
+    ----------
+    candidate : Candidate
+    runs : tuple of RunEnvelope
+    transient : tuple of (ndarray or None)
+        Each run's factor at theta_ref (None: 1, the first-order envelope alone).
+    theta_ref : ndarray or None
+        Where the factors were taken (None: nowhere, every factor 1).
     """
-    space = c.grown
-    given = dict(zip(space.names, map(float, theta0)))  # the space's leading columns
-    th0 = space.vector(given, default={p.name: p.start for p in c.effect_params})
-    if refresh:
-        runs = with_transient(c, th0, runs)
-        fit = fit_candidate(c, runs, th0, starts=starts, max_nfev=max_nfev, free_joint=free_joint)
-        for _ in range(refresh):
-            runs = with_transient(c, fit.theta, runs)
-            again = fit_candidate(c, runs, fit.theta, starts=1, max_nfev=max_nfev, free_joint=free_joint)
-            fit = replace(again, n_eval=again.n_eval + fit.n_eval)
-        return fit
+
+    candidate: Candidate
+    runs: tuple[RunEnvelope, ...]
+    transient: tuple[NDArray[np.complex128] | None, ...] = ()
+    theta_ref: NDArray[np.float64] | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "runs", tuple(self.runs))
+        if not self.transient:
+            object.__setattr__(self, "transient", (None,) * len(self.runs))
+
+    def at(self, theta: NDArray) -> Objective:
+        """The same candidate and runs linearised at theta (n,): every run's transient factor taken there."""
+        th = np.asarray(theta, dtype=float)
+        return Objective(self.candidate, self.runs, tuple(transient_factor(self.candidate, th, r) for r in self.runs),
+                         th)
+
+    def subset(self, idx: Sequence[int]) -> Objective:
+        """The objective on the runs `idx` (their factors kept)."""
+        return Objective(self.candidate, tuple(self.runs[i] for i in idx), tuple(self.transient[i] for i in idx),
+                         self.theta_ref)
+
+    def predict(self, theta: NDArray, i: int) -> NDArray[np.complex128]:
+        """Run i's measured quantity as the model gives it at its frames as the sweep shows it, (P, n) or (n,):
+        the first-order envelope times the run's transient factor, `observed`."""
+        c, run, k = self.candidate, self.runs[i], self.transient[i]
+        T = _first_order_runs(c, theta, [run])[0]
+        return observed(model_at(c, theta, run.row), T if k is None else T * k, run)
+
+    def residuals(self, theta: NDArray) -> NDArray:
+        """Residual vector whose sum of squares is E^2 (theta (n,) -> (m,), (P, n) -> (P, m))."""
+        c, runs = self.candidate, self.runs
+        with np.errstate(all="ignore"):
+            T = _first_order_runs(c, theta, runs)
+            model = model_at(c, theta, runs[0].row)  # its sensor (no effect changes it along the sequence)
+            r = np.concatenate([_run_residual(model, t if k is None else t * k, run, len(runs))
+                                for t, k, run in zip(T, self.transient, runs)], axis=-1)
+        return np.where(np.isfinite(r), r, 1e3)
+
+    def E(self, theta: NDArray) -> float:
+        """E of the fast model at theta over the runs (the validation's definition)."""
+        return float(np.sqrt(np.sum(self.residuals(theta) ** 2)))
+
+    def fit(self, theta0: NDArray, *, starts: int = 3, max_nfev: int = 60, free_joint: bool = True,
+            refresh: int = 0) -> Fit:
+        """Bounded least squares of E^2 over the candidate's unit cube, from theta0 and effect start values.
+
+        theta0 : (6,) or (n,) physical start, in the candidate's column order (the joint's parameters
+        alone, or with effect values; the effect values it does not give default to their `start`).
+        starts : effect starts tried (the `start` value and evenly spread points of the unit interval,
+        for the effect parameters theta0 does not give). free_joint : False holds the joint parameters.
+        refresh : times the transient factor is retaken (at theta0 first, then at each optimum,
+        refitting from it); 0 keeps this objective's factors.
+        """
+        c = self.candidate
+        space = c.grown
+        given = dict(zip(space.names, map(float, theta0)))  # the space's leading columns
+        th0 = space.vector(given, default={p.name: p.start for p in c.effect_params})
+        if refresh:
+            fit = self.at(th0).fit(th0, starts=starts, max_nfev=max_nfev, free_joint=free_joint)
+            for _ in range(refresh):
+                again = self.at(fit.theta).fit(fit.theta, starts=1, max_nfev=max_nfev, free_joint=free_joint)
+                fit = replace(again, n_eval=again.n_eval + fit.n_eval)
+            return fit
+        return _least_squares(self, th0, given, starts, max_nfev, free_joint)
+
+
+def _least_squares(obj: Objective, th0: NDArray, given: Mapping[str, float], starts: int, max_nfev: int,
+                   free_joint: bool) -> Fit:
+    """`Objective.fit` at fixed transient factors: trust-region least squares from th0 and the effect starts,
+    the Jacobian one batched call of the fast model over the perturbed parameter sets."""
+    c, space = obj.candidate, obj.candidate.grown
     u0 = np.clip(c.to_unit(th0), 1e-6, 1 - 1e-6)
     # beta is barely identifiable from envelopes and sits on its floor in most joints: held
     free = space.free_mask(HELD if free_joint else (*PARAMS, *HELD))
@@ -242,7 +281,7 @@ def fit_candidate(c: Candidate, runs: Sequence[RunEnvelope], theta0: NDArray, *,
 
     def fun(v):
         count[0] += 1
-        last["v"], last["r"] = np.array(v, dtype=float), residuals(c, c.to_physical(full(v)), runs)
+        last["v"], last["r"] = np.array(v, dtype=float), obj.residuals(c.to_physical(full(v)))
         return last["r"]
 
     def jac(v):
@@ -252,7 +291,7 @@ def fit_candidate(c: Candidate, runs: Sequence[RunEnvelope], theta0: NDArray, *,
         step = np.where(u[idx] + h <= 1, h, -h)
         U[np.arange(idx.size), idx] += step
         count[0] += 1
-        R = residuals(c, c.to_physical(U), runs)
+        R = obj.residuals(c.to_physical(U))
         r0 = last["r"] if "v" in last and np.array_equal(last["v"], v) else fun(v)
         return ((R - r0) / step[:, None]).T
 

@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 from ..validate.drive import equivalent_base
 from ..validate.error import BINS
 from .data import RunEnvelope, run_zeta
-from .fit import Candidate, predict, with_transient
+from .fit import Candidate, Objective
 
 __all__ = ["fast_floor"]
 
@@ -42,7 +42,7 @@ def _at_frames(run: RunEnvelope, frame: pd.DataFrame, sdb: NDArray, sdeg: NDArra
     b = np.clip(np.digitize(x, BINS[1:-1]), 0, len(BINS) - 2)
     f = fr["f_hz"].to_numpy(float)
     eq = None if run.equivalent_base is None else equivalent_base(run.row, f)
-    return replace(run, f_hz=f, base_g=base, T=T, sigma_db=sdb[b], sigma_deg=sdeg[b], t_s=t, transient=None,
+    return replace(run, f_hz=f, base_g=base, T=T, sigma_db=sdb[b], sigma_deg=sdeg[b], t_s=t,
                    equivalent_base=eq)
 
 
@@ -74,8 +74,7 @@ def fast_floor(c: Candidate, theta: NDArray, runs: Sequence[RunEnvelope], frames
         at = _at_frames(run, frames[rid], sigma_db, sigma_deg) if rid in frames else None
         if at is None:
             continue
-        at = with_transient(c, theta, [at])[0]
-        d = predict(c, theta, at) / at.T
+        d = Objective(c, [at]).at(theta).predict(theta, 0) / at.T
         rows.append((rid, at.level, np.mean((20 * np.log10(np.abs(d)) / at.sigma_db) ** 2),
                      np.mean((np.degrees(np.angle(d)) / at.sigma_deg) ** 2)))
     if not rows:

@@ -8,7 +8,7 @@ The candidate's space is the calibration's grown by the effect's parameters
    transient at the best least-squares start). The seeded initial population holds the
    candidate's least-squares fits (from the calibration's optimum and from the GA's other
    Fs valleys), so the GA explores around and between them.
-2. Polish: bounded least squares from the GA's best (`fit.fit_candidate`, the transient
+2. Polish: bounded least squares from the GA's best (`fit.Objective.fit`, the transient
    refreshed at its optimum).
 3. Posterior: `jointcal.posterior.ResidualPosterior` (uniform prior on the unit cube,
    log L = -N E^2 / (2 T), N the number of residuals -- each frame's magnitude and phase
@@ -36,7 +36,7 @@ from ..posterior.likelihood import ResidualPosterior
 from ..posterior.sampler import sample_ball
 from ..posterior.summary import draw_quantiles
 from .data import RunEnvelope
-from .fit import HELD, Candidate, Fit, fit_candidate, residuals, with_transient
+from .fit import HELD, Candidate, Fit, Objective
 
 __all__ = ["Recalibration", "recalibrate"]
 
@@ -71,10 +71,10 @@ class Recalibration:
         return [float(self.quantiles.at[name, "q05"]), float(self.quantiles.at[name, "q95"])]
 
 
-def _posterior(c: Candidate, runs: Sequence[RunEnvelope], at: Fit, temperature: float) -> ResidualPosterior:
-    """E^2 of candidate `c` on `runs` as a posterior over its free columns, the held ones at `at`'s values."""
-    space = c.grown
-    return ResidualPosterior(space, lambda theta: residuals(c, theta, runs), residuals(c, at.theta, runs).size,
+def _posterior(obj: Objective, at: Fit, temperature: float) -> ResidualPosterior:
+    """E^2 of the objective as a posterior over its free columns, the held ones at `at`'s values."""
+    space = obj.candidate.grown
+    return ResidualPosterior(space, obj.residuals, obj.residuals(at.theta).size,
                              temperature, np.clip(space.to_unit(at.theta), 0.0, 1.0), space.free_mask(HELD))
 
 
@@ -87,16 +87,15 @@ def recalibrate(c: Candidate, runs: Sequence[RunEnvelope], starts: Sequence[Fit]
     seeded into the GA's initial population. seed : seeds the GA and the sampler.
     """
     first = min(starts, key=lambda f: f.E)
-    runs = with_transient(c, first.theta, runs)  # the sweep transient at the best start
-    lp = _posterior(c, runs, first, 1.0)
+    obj = Objective(c, runs).at(first.theta)  # the sweep transient at the best start
+    lp = _posterior(obj, first, 1.0)
     init = np.array([np.clip(c.to_unit(f.theta), 0.0, 1.0)[lp.free] for f in starts]).reshape(-1, lp.ndim)
     options = GAOptions(population=population, offspring=population, generations=generations, stall_generations=8,
                         seed=seed)
     ga = search(lp.misfit_unit, c.grown, options, free=lp.free, at=lp.at, init=init)
-    pol = fit_candidate(c, runs, lp.physical(ga.best[None])[0], starts=1, max_nfev=max_nfev, refresh=1)
+    pol = obj.fit(lp.physical(ga.best[None])[0], starts=1, max_nfev=max_nfev, refresh=1)
     best = min([pol, *starts], key=lambda f: f.E)
-    runs = with_transient(c, best.theta, runs)
-    lp = _posterior(c, runs, best, max(best.E**2, 1.0))  # the chain holds beta at the chosen fit's value
+    lp = _posterior(obj.at(best.theta), best, max(best.E**2, 1.0))  # the chain holds beta at the chosen fit's value
     # the Gauss-Newton width, within [0.003, 0.01] of the unit cube: a flat direction must not
     # start as a point, or the ensemble explores it too slowly
     sd = np.sqrt(np.clip(np.diag(best.cov_unit)[lp.free], 9e-6, 1e-4))

@@ -38,7 +38,7 @@ import numpy as np
 
 from .data import RunEnvelope
 from ..io import level_column
-from .fit import Candidate, Fit, envelope_E, fit_candidate, with_transient
+from .fit import Candidate, Fit, Objective
 
 __all__ = ["PENALTY_PER_PARAM", "Scored", "score_candidates"]
 
@@ -88,17 +88,16 @@ def _extrapolates_sequence(runs: Sequence[RunEnvelope], idx: list[int]) -> bool:
     return bool(outside.mean() > 0.5)
 
 
-def _held_out(c: Candidate, runs: Sequence[RunEnvelope], full: Fit, max_nfev: int,
-              folds: dict[str, list[int]]) -> dict[str, float]:
-    """E of the candidate refit without each fold, on that fold (folds it cannot be judged on left out)."""
+def _held_out(obj: Objective, full: Fit, max_nfev: int, folds: dict[str, list[int]]) -> dict[str, float]:
+    """E of the candidate refit without each fold, on that fold (folds it cannot be judged on left out); the
+    objective is linearised at the full fit."""
     per = {}
     for name, idx in folds.items():
-        if c.sequence_dependent and _extrapolates_sequence(runs, idx):
+        if obj.candidate.sequence_dependent and _extrapolates_sequence(obj.runs, idx):
             continue
-        test = [runs[i] for i in idx]
-        train = [r for i, r in enumerate(runs) if i not in set(idx)]
-        f = fit_candidate(c, train, full.theta, starts=1, max_nfev=max_nfev)
-        per[name] = envelope_E(c, f.theta, test)
+        train = [i for i in range(len(obj.runs)) if i not in set(idx)]
+        f = obj.subset(train).fit(full.theta, starts=1, max_nfev=max_nfev)
+        per[name] = obj.subset(idx).E(f.theta)
     return per
 
 
@@ -125,11 +124,11 @@ def score_candidates(cands: Sequence[Candidate], runs: Sequence[RunEnvelope], th
     base_score = baseline.score if baseline is not None else None
     for c in cands:
         t0 = time.perf_counter()
-        fits = [fit_candidate(c, runs, start, starts=1 if c.name == "baseline" else 3, max_nfev=max_nfev, refresh=1)
+        obj = Objective(c, runs)
+        fits = [obj.fit(start, starts=1 if c.name == "baseline" else 3, max_nfev=max_nfev, refresh=1)
                 for start in (starts or {}).get(c.name, [theta_base])]
         full = min(fits, key=lambda f: f.E)
-        runs_c = with_transient(c, full.theta, runs)
-        per = _held_out(c, runs_c, full, max_nfev, folds) if folds else {}
+        per = _held_out(obj.at(full.theta), full, max_nfev, folds) if folds else {}
         if c.name == "baseline":
             base_per = per
             s = _rms(per.values()) if per else full.E

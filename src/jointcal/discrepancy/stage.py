@@ -36,7 +36,7 @@ from ..validate.drive import drive_gain
 from ..validate import ValidateSettings, model_from_best, validate_runs
 from .data import run_envelope, scale_arrays
 from .fingerprints import fingerprints, outside_library, residual_map, verdicts
-from .fit import candidate, fit_candidate, model_at, structure_scales, with_transient
+from .fit import Objective, candidate, model_at, structure_scales
 from .floor import fast_floor
 from .recalibrate import recalibrate
 from .rule import CLAUSES, confirm, decide, needs_pairs, pair_bases, pair_names
@@ -237,7 +237,7 @@ def _score_library(assembly, space, m, runs, theta0, F, settings, joint_starts, 
 def _localise(c0, base, runs, mrows, m, sdb):
     """Residuals of the baseline refit, the fingerprints, each effect's verdicts and what points
     outside the library."""
-    res = residual_map(c0, base.fit.theta, with_transient(c0, base.fit.theta, runs))
+    res = residual_map(Objective(c0, runs).at(base.fit.theta), base.fit.theta)
     usable = mrows.loc[[r.row["run_id"] for r in runs]].reset_index()
     jb = dict(zip(PARAMS, base.fit.theta))
     f, z = backbone_at(jb, m, usable["q_in"].to_numpy(float))
@@ -257,7 +257,7 @@ def _recalibrated(assembly, final, space, m, runs, joint_starts, settings, say, 
     fits = [final.fit]
     for th in joint_starts:
         start = _with_joint(cf, final.fit.theta, th)
-        alt = fit_candidate(cf, runs, start, starts=1, max_nfev=2 * settings.max_nfev, refresh=1)
+        alt = Objective(cf, runs).fit(start, starts=1, max_nfev=2 * settings.max_nfev, refresh=1)
         say(f"{assembly}: {final.name} refit from Fs = {cf.grown.column(start, 'Fs'):.3g} lbf: E {alt.E:.2f}")
         fits.append(alt)
     rec = recalibrate(cf, runs, fits, seed=settings.seed, generations=settings.ga_generations,
