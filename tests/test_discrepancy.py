@@ -15,7 +15,8 @@ import pytest
 
 from jointcal.calibrate import CalibrateSettings, run_calibration
 from jointcal.calibrate.space import PARAMS
-from jointcal.discrepancy import EFFECTS, DiscrepancySettings, decide, diagnose, diagnosis_markdown, score_candidates
+from jointcal.discrepancy import DiscrepancySettings, decide, diagnose, diagnosis_markdown, score_candidates
+from jointcal.effects import EFFECTS
 from jointcal.discrepancy.data import RunEnvelope
 from jointcal.discrepancy.fit import Objective, candidate, model_at
 from jointcal.discrepancy.rule import NONE_E, confirm

@@ -8,12 +8,13 @@ frames and the run's drive), `fit` (the swept fast-model envelope objective and 
 (residual maps, fingerprint features), `select` (held-out scoring, forward selection), `rule`
 (the decision rule), `recalibrate` (GA, polish, posterior of the chosen model), `stage`
 (one assembly, end to end), `words` (the diagnosis in plain language).
+
+The effects themselves are imported from `jointcal.effects` (one import path).
 """
-from ..effects import EFFECTS, Effect, EffectParam, apply_effect
 from .rule import decide
 from .select import score_candidates
 from .stage import DiscrepancySettings, diagnose
 from .words import diagnosis_markdown
 
-__all__ = ["EFFECTS", "Effect", "EffectParam", "apply_effect", "decide", "score_candidates",
+__all__ = ["decide", "score_candidates",
            "DiscrepancySettings", "diagnose", "diagnosis_markdown"]

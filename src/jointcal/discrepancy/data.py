@@ -20,7 +20,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from ..models import SweepDrive
-from ..measure.envelopes import window_length
+from ..measure.envelopes import ZETA_MIN, window_length
 from ..measure.peaks import full_drive, transmissibility
 from ..io import level_column
 from ..validate.drive import equivalent_base
@@ -104,7 +104,7 @@ def _window_s(row: Mapping, zeta_min: float) -> float | None:
 
 def run_envelope(env: pd.DataFrame, row: Mapping, sigma_db: NDArray, sigma_deg: NDArray, *,
                  band: tuple[float, float] = (0.6, 1.4), max_frames: int = 160,
-                 zeta_min: float = 0.01) -> RunEnvelope | None:
+                 zeta_min: float = ZETA_MIN) -> RunEnvelope | None:
     """The frames of one run used by the discrepancy fits (None when the run is unusable).
 
     Parameters

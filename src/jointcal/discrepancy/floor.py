@@ -7,7 +7,7 @@ envelope model) gives the same model's envelope; their difference, in the valida
 definition of E (per-bin repeat scatter, every run weighted equally), is the floor below
 which the fast model cannot tell a missing effect from its own approximation. Reported
 per level and overall; the decision takes it out of the baseline's score
-(`select.decide`), and the diagnosis states it.
+(`rule.decide`), and the diagnosis states it.
 """
 from __future__ import annotations
 

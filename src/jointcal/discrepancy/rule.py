@@ -18,7 +18,7 @@ from ..effects import EFFECTS, JOIN, effects_of
 if TYPE_CHECKING:
     from .select import Scored
 
-__all__ = ["NONE_E", "CLOSE_FRACTION", "MARGIN", "WITHIN_SCATTER", "FLOOR_HIGH", "CLAUSES", "RULE", "Decision",
+__all__ = ["NONE_E", "CLOSE_FRACTION", "MARGIN", "WITHIN_SCATTER", "FLOOR_HIGH", "HIGH_SCORE", "NONE_HIGH", "CLAUSES", "RULE", "Decision",
            "decide", "confirm", "needs_pairs", "pair_bases", "pair_names"]
 
 NONE_E = 1.5
@@ -26,23 +26,26 @@ CLOSE_FRACTION = 0.6
 MARGIN = 0.7
 WITHIN_SCATTER = 0.5
 FLOOR_HIGH = 1.0  # a fast-model floor above this (the repeat scatter) caps every confidence at medium
+HIGH_SCORE = 2.0  # a name is held with confidence high only at a held-out score at or below this
+NONE_HIGH = 0.8  # a 'none' is high unless the best single effect scores below this fraction of the baseline
 
 CLAUSES: dict[str, str] = {
     "scores": ("Scores S are held-out fast-model E (1 = the repeat scatter), S_b the baseline's, F the fast model's "
                "floor."),
-    "none": f"'none' if sqrt(S_b^2 - F^2) <= {NONE_E}",
+    "none": (f"'none' if sqrt(S_b^2 - F^2) <= {NONE_E} (high unless the best single effect scores below "
+             f"{NONE_HIGH} x S_b: then medium)"),
     "drift": (f"(unless the best single effect changes with the run sequence, whose drift inflates the repeat "
               f"scatter, and scores <= {WITHIN_SCATTER} x S_b and <= {MARGIN} x the runner-up: named, medium; "
               f"forward selection then goes on from it, and a pair with it that scores <= {MARGIN} x it and x the "
               "next pair is named instead, medium)."),
     "single": (f"Otherwise a single effect is named if it closes >= {CLOSE_FRACTION:.0%} of the baseline's excess "
-               f"over 1 and scores <= {MARGIN} x the runner-up (high when its score <= 2)."),
+               f"over 1 and scores <= {MARGIN} x the runner-up (high when its score <= {HIGH_SCORE:g})."),
     "pair": (f"If the best single scores above {NONE_E}, effects are added to it one at a time (forward "
              f"selection); a pair is named instead when it closes >= {CLOSE_FRACTION:.0%} of the excess, scores <= "
-             f"{MARGIN} x the best single and <= {MARGIN} x the next pair (high when its score <= 2)."),
+             f"{MARGIN} x the best single and <= {MARGIN} x the next pair (high when its score <= {HIGH_SCORE:g})."),
     "unexplained": "Otherwise unexplained.",
-    "outside": ("A fingerprint no library effect leaves (a dominant even harmonic) keeps a name only at score <= 2, "
-                "with confidence medium;"),
+    "outside": (f"A fingerprint no library effect leaves (a dominant even harmonic) keeps a name only at score <= "
+                f"{HIGH_SCORE:g}, with confidence medium;"),
     "floor": f"a floor F > {FLOOR_HIGH} caps confidence at medium.",
     "none_contradicted": (f"A 'none' the time simulation contradicts (E > {NONE_E} before and after the refit) "
                           "becomes unexplained."),
@@ -123,15 +126,15 @@ def _rule(sb, s1, s2, singles, pairs, outside, floor) -> tuple[str, str, tuple[s
             if pairs and _drifts(pairs[0].name) and _pair_wins(pairs, s1):
                 return pairs[0].name, "medium", ("none", "drift")
             return singles[0].name, "medium", ("none", "drift")
-        return "none", "high" if (not singles or s1 > 0.8 * sb) else "medium", ("none",)
+        return "none", "high" if (not singles or s1 > NONE_HIGH * sb) else "medium", ("none",)
     if pairs:
         p1 = pairs[0].score
-        if _closes(sb, p1) and _pair_wins(pairs, s1) and not (outside and p1 > 2.0):
-            return pairs[0].name, "high" if (p1 <= 2.0 and not outside) else "medium", ("pair", *out)
+        if _closes(sb, p1) and _pair_wins(pairs, s1) and not (outside and p1 > HIGH_SCORE):
+            return pairs[0].name, "high" if (p1 <= HIGH_SCORE and not outside) else "medium", ("pair", *out)
     if not singles:
         return "unexplained", "low", ("unexplained",)
-    if _closes(sb, s1) and s1 <= MARGIN * s2 and not (outside and s1 > 2.0):
-        return singles[0].name, "high" if (s1 <= 2.0 and not outside) else "medium", ("single", *out)
+    if _closes(sb, s1) and s1 <= MARGIN * s2 and not (outside and s1 > HIGH_SCORE):
+        return singles[0].name, "high" if (s1 <= HIGH_SCORE and not outside) else "medium", ("single", *out)
     return "unexplained", "low", ("single", "pair", "unexplained", *out) if pairs else ("single", "unexplained", *out)
 
 

@@ -33,6 +33,8 @@ from ..calibrate.kind import backbone_at
 from ..io import level_column
 from ..io.contract import LEVEL
 from ..validate.drive import drive_gain
+from ..measure.envelopes import ZETA_MIN
+from ..posterior.sampler import TAU_FACTOR
 from ..validate import ValidateSettings, model_from_best, validate_runs
 from .data import run_envelope, scale_arrays
 from .fingerprints import fingerprints, outside_library, residual_map, verdicts
@@ -130,7 +132,7 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     clock.lap("validate_before")
     sdb, sdeg = scale_arrays(scale)
     mrows = modal[modal["assembly"] == assembly].set_index("run_id")
-    runs = _usable_runs(assembly, envs, mrows, rows, sdb, sdeg, settings, float((envelopes_kw or {}).get("zeta_min", 0.01)))
+    runs = _usable_runs(assembly, envs, mrows, rows, sdb, sdeg, settings, float((envelopes_kw or {}).get("zeta_min", ZETA_MIN)))
     say(f"{assembly}: {len(runs)} usable runs, {sum(r.f_hz.size for r in runs)} envelope frames")
     c0 = candidate("baseline", space, m, scales)
     floor = fast_floor(c0, theta0, runs, frames_before, sdb, sdeg)
@@ -278,7 +280,7 @@ def _recalibrated_json(final, cf, rec, n_fits) -> dict:
             "method": (f"DEAP GA ({rec.ga_generations} generations, best E {rec.ga_best_E:.3g}) seeded "
                        f"with {n_fits} least-squares fits, polished; emcee {rec.steps} steps x {rec.walkers} "
                        f"walkers, max tau {rec.tau_max:.0f} steps"
-                       + ("" if rec.converged else " (short of 50 tau: intervals approximate)")
+                       + ("" if rec.converged else f" (short of {TAU_FACTOR:g} tau: intervals approximate)")
                        + "; intervals are the 5-95% posterior quantiles"),
             "posterior_converged": rec.converged}
 

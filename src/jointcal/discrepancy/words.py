@@ -1,6 +1,6 @@
 """The diagnosis in words: what is missing, what to check, and every number in agreement with the verdict.
 
-Three verdicts (`select.decide`, then the time-domain check of `stage.diagnose`):
+Three verdicts (`rule.decide`, then the time-domain check of `stage.diagnose`):
 
 * a name (one effect, or two found by forward selection): the advice of each effect, the
   time-domain E before and after (and, when it did not fall, that the time simulation
@@ -20,7 +20,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from ..effects import EFFECTS
-from .rule import NONE_E
+from .rule import FLOOR_HIGH, NONE_E
 
 __all__ = ["diagnosis_markdown"]
 
@@ -39,7 +39,7 @@ def _floor(d: Mapping) -> str:
             f"same model, same runs and bins) is E = {fl['E']:.2f}" + (f" ({per})" if per else "") + ": "
             + ("well below the repeat scatter, so the held-out scores measure the model, not the fast model."
                if fl["E"] <= 0.5 else "a share of the scores above is the fast model's own; the decision takes it out "
-               "of the baseline's score." if fl["E"] <= 1.0 else
+               "of the baseline's score." if fl["E"] <= FLOOR_HIGH else
                "as large as the repeat scatter: the confidence is capped at medium."))
 
 

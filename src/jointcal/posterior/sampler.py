@@ -33,7 +33,9 @@ import numpy as np
 import scipy.fft
 from numpy.typing import NDArray
 
-__all__ = ["ChainResult", "run_chain", "sample_ball", "projected_steps", "random_state_arrays", "random_state_tuple"]
+__all__ = ["TAU_FACTOR", "ChainResult", "run_chain", "sample_ball", "projected_steps", "random_state_arrays", "random_state_tuple"]
+
+TAU_FACTOR = 50.0  # chain length over the largest autocorrelation time that counts as converged (the config's default)
 
 
 @dataclass
@@ -140,7 +142,7 @@ def projected_steps(hist: NDArray[np.float64] | list, tau_factor: float = 50.0, 
 
 
 def run_chain(log_prob: Callable[[NDArray[np.float64]], NDArray[np.float64]], x0: NDArray[np.float64], *,
-              seed: int, max_steps: int, chunk: int = 1000, tau_factor: float = 50.0, tau_rtol: float = 0.05,
+              seed: int, max_steps: int, chunk: int = 1000, tau_factor: float = TAU_FACTOR, tau_rtol: float = 0.05,
               stop_projected: float = 0.0, min_chunks: int = 5,
               observe: Callable[[NDArray[np.float64]], NDArray[np.float64]] | None = None,
               resume: dict[str, Any] | None = None,
