@@ -22,7 +22,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..models import harmonic_balance, qsma
+from ..models import harmonic_balance, population_curves, qsma
 from .space import PARAMS
 
 __all__ = ["PENALTY", "Model", "MODELS", "predict", "objective"]
@@ -62,9 +62,12 @@ def predict(theta: ArrayLike, q: ArrayLike, *, m: float, model: Model = "harmoni
     theta = np.atleast_2d(np.asarray(theta, dtype=float))
     if theta.shape[-1] != len(PARAMS):
         raise ValueError(f"theta must have {len(PARAMS)} columns ({', '.join(PARAMS)}), got shape {theta.shape}")
+    q = np.asarray(q, dtype=float)
+    if q.ndim == 1 and theta.ndim == 2 and np.ndim(m) == 0:  # a population at the same amplitudes: one kernel call
+        return population_curves(theta, q, m, harmonic=model == "harmonic_balance", viscous=viscous)
     v = dict(zip(PARAMS, np.split(theta, len(PARAMS), axis=1)))  # the joint's columns by name, (P, 1) each
     fn = MODELS[model]
-    return fn(np.asarray(q, dtype=float), v["Fs"], v["KT"], v["chi"], v["beta"], v["k"], m,  # type: ignore[operator]
+    return fn(q, v["Fs"], v["KT"], v["chi"], v["beta"], v["k"], m,  # type: ignore[operator]
               v["zeta_v"], viscous=viscous)
 
 

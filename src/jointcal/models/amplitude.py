@@ -25,9 +25,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..units import G
+from . import _amplitude_kernel
 from .iwan import derived, dissipation
 
-__all__ = ["jenkins_inphase", "qsma", "harmonic_balance", "resonance_amplitude", "G"]
+__all__ = ["jenkins_inphase", "qsma", "harmonic_balance", "population_curves", "resonance_amplitude", "G"]
 
 Viscous = Literal["dashpot", "constant"]
 
@@ -125,6 +126,96 @@ def qsma(q, Fs, KT, chi, beta, k, m, zeta_v, *, viscous: Viscous = "constant"):
         Damping ratio, D(q)/(2 pi k_sec q^2) + viscous part.
     All inputs broadcast; e.g. parameters of shape (P, 1) and q of shape (N,).
     """
+    return _curves(q, Fs, KT, chi, beta, k, m, zeta_v, harmonic=False, viscous=viscous)
+
+
+def harmonic_balance(q, Fs, KT, chi, beta, k, m, zeta_v, *, viscous: Viscous = "dashpot"):
+    """First-harmonic balance (describing function) frequency and damping.
+
+    k_df(q) = k + KT - R q^(chi+1) J(min(1, phi_max/q)) - S (1 - g(phi_max/q)),
+    the last term only past macroslip (q > phi_max); omega = sqrt(k_df/m);
+    zeta = D(q) / (2 pi k_df q^2) + viscous part. Arguments and returns as `qsma`.
+    """
+    return _curves(q, Fs, KT, chi, beta, k, m, zeta_v, harmonic=True, viscous=viscous)
+
+
+def population_curves(theta: ArrayLike, q: ArrayLike, m: float, *, harmonic: bool = True,
+                      viscous: Viscous = "dashpot") -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """`harmonic_balance` (or `qsma`) of many parameter sets at the same amplitudes, for a population.
+
+    Parameters
+    ----------
+    theta : array_like, shape (P, 6)
+        Fs (lbf), KT (lbf/in), chi, beta, k (lbf/in), zeta_v per parameter set.
+    q : array_like, shape (N,)
+        Modal amplitudes, in (> 0).
+    m : float
+        Slug mass, lbf s^2/in.
+    harmonic : bool
+        True: `harmonic_balance`; False: `qsma`.
+    viscous : {'dashpot', 'constant'}
+        Viscous convention (see the module notes).
+
+    Returns
+    -------
+    f, zeta : ndarray, shape (P, N)
+        Frequency, Hz, and damping ratio; the same values as
+        ``harmonic_balance(q, *theta[:, :5].T[..., None], m, theta[:, 5:])`` (one call of the kernel,
+        without the broadcasting).
+    """
+    theta = np.asarray(theta, dtype=float)
+    rows = np.empty((theta.shape[0], 7))  # the kernel's columns: the six, then m
+    rows[:, :6] = theta
+    rows[:, 6] = m
+    return _run(np.asarray(q, dtype=float).reshape(1, -1), rows, harmonic, viscous)
+
+
+def _run(q2: NDArray[np.float64], rows: NDArray[np.float64], harmonic: bool, viscous: Viscous):
+    """The kernel on amplitudes q2 (P or 1, N) and parameter rows (P, 7); returns f, zeta (P, N)."""
+    if viscous not in ("dashpot", "constant"):
+        raise ValueError(f"viscous must be 'dashpot' or 'constant', got {viscous!r}.")
+    if np.any(q2 <= 0) and rows.shape[0]:
+        raise ValueError("Modal amplitudes q must be positive displacements in inches.")
+    q2 = np.require(q2, dtype=float, requirements=("C", "W"))  # one signature: C-contiguous, writeable
+    f, zeta = np.empty((rows.shape[0], q2.shape[1])), np.empty((rows.shape[0], q2.shape[1]))
+    _amplitude_kernel.curves(q2, rows, harmonic, viscous == "dashpot", _NODES, _WEIGHTS, f, zeta)
+    return f, zeta
+
+
+def _curves(q, Fs, KT, chi, beta, k, m, zeta_v, *, harmonic: bool, viscous: Viscous):
+    """`harmonic_balance` (harmonic=True) or `qsma` by the numba kernel (`_amplitude_kernel.curves`).
+
+    The kernel takes parameter sets as rows (P, 7) and amplitudes as columns (P or 1, N): parameters
+    constant along the last axis (a population (P, 1), or scalars) keep that layout, any other
+    broadcast becomes one row per point.
+    """
+    q = np.asarray(q, dtype=float)
+    params = [np.asarray(a, dtype=float) for a in (Fs, KT, chi, beta, k, zeta_v, m)]  # the kernel's columns
+    shape = np.broadcast_shapes(q.shape, *(p.shape for p in params))
+    full = shape or (1,)
+    if all(p.ndim == 0 or p.shape[-1] == 1 for p in params):  # one parameter set per row
+        lead, n = full[:-1], full[-1]
+        count = int(np.prod(lead, dtype=int))
+        rows = np.empty((count, 7))
+        for j, p in enumerate(params):
+            rows[:, j] = np.broadcast_to(p, (*lead, 1)).reshape(count)
+        one = q.ndim <= 1 or all(d == 1 for d in q.shape[:-1])
+        q2 = np.broadcast_to(q.reshape(-1) if one else q, (n,) if one else full).reshape(1 if one else count, n)
+    else:  # one parameter set per point
+        count = int(np.prod(full, dtype=int))
+        rows = np.empty((count, 7))
+        for j, p in enumerate(params):
+            rows[:, j] = np.broadcast_to(p, full).reshape(count)
+        q2 = np.broadcast_to(q, full).reshape(count, 1)
+    f, zeta = _run(q2, rows, harmonic, viscous)
+    return f.reshape(shape)[()], zeta.reshape(shape)[()]  # [()]: a numpy scalar for scalar inputs, as numpy
+
+
+# The whole-array numpy expressions the kernel follows, kept as its reference
+# (tests/models/test_amplitude_kernel.py, tests/benchmarks/bench_posterior_step.py).
+
+def _qsma_numpy(q, Fs, KT, chi, beta, k, m, zeta_v, *, viscous: Viscous = "constant"):
+    """`qsma` in numpy (same arguments and returns)."""
     q, Fs, KT, chi, beta, phi_max, R, S = _joint(q, Fs, KT, chi, beta)
     u = np.minimum(q, phi_max)
     Fb = np.where(q >= phi_max, Fs, KT * u - R * u ** (chi + 2.0) / ((chi + 1.0) * (chi + 2.0)))
@@ -136,13 +227,8 @@ def qsma(q, Fs, KT, chi, beta, k, m, zeta_v, *, viscous: Viscous = "constant"):
     return omega / (2.0 * np.pi), zeta
 
 
-def harmonic_balance(q, Fs, KT, chi, beta, k, m, zeta_v, *, viscous: Viscous = "dashpot"):
-    """First-harmonic balance (describing function) frequency and damping.
-
-    k_df(q) = k + KT - R q^(chi+1) J(min(1, phi_max/q)) - S (1 - g(phi_max/q)),
-    the last term only past macroslip (q > phi_max); omega = sqrt(k_df/m);
-    zeta = D(q) / (2 pi k_df q^2) + viscous part. Arguments and returns as `qsma`.
-    """
+def _harmonic_balance_numpy(q, Fs, KT, chi, beta, k, m, zeta_v, *, viscous: Viscous = "dashpot"):
+    """`harmonic_balance` in numpy (same arguments and returns)."""
     q, Fs, KT, chi, beta, phi_max, R, S = _joint(q, Fs, KT, chi, beta)
     smax = np.minimum(1.0, phi_max / q)
     k_df = k + KT - R * q ** (chi + 1.0) * _J_broadcast(chi, smax)

@@ -78,9 +78,12 @@ class SteadyState:
 
 
 def batch_field(value, shape) -> NDArray[np.float64]:
-    """A model field broadcast to the parameter batch (P,) (constant along frequency)."""
+    """A model field broadcast to the parameter batch (P,) (constant along frequency).
+
+    Always a new C-contiguous, writeable array: a read-only broadcast view would compile the kernels
+    again for read-only arguments."""
     a = np.broadcast_to(np.asarray(value, dtype=float), shape)
-    return np.ascontiguousarray(a.reshape(-1, shape[-1])[:, 0])
+    return np.array(a.reshape(-1, shape[-1])[:, 0], dtype=float, order="C")
 
 
 def batch_shape(model: MinistackModel, f_shape: tuple) -> tuple[tuple[int, int], tuple]:

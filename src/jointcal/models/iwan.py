@@ -137,5 +137,5 @@ def force_history(u: ArrayLike, p: IwanParams) -> tuple[NDArray[np.float64], NDA
     if not np.all(np.isfinite(u)):
         raise ValueError("force_history: the displacement history holds NaN or inf.")
     phi_max, R, _ = derived(p.Fs, p.KT, p.chi, p.beta)
-    R1, e = _masing.kernel_constants(R, p.chi)
-    return _masing.force_history(u, p.KT, R1, e, float(phi_max), p.Fs)
+    R1, e = _masing.kernel_constants(R, p.chi)  # floats throughout: one compiled signature
+    return _masing.force_history(u, float(p.KT), float(R1), float(e), float(phi_max), float(p.Fs))

@@ -1,6 +1,6 @@
 """Compile the numba kernels once, before the stages that call them run side by side.
 
-The kernels (`_envelope_kernel`, `_integrator`, `_masing`) are compiled on first call and
+The kernels (`_envelope_kernel`, `_integrator`, `_masing`, `_amplitude_kernel`) are compiled on first call and
 cached by numba next to their source (``cache=True``). On a fresh install the cache is
 empty, and every process that calls a kernel before another has written it compiles it
 again: on the example campaign that was about 35 s of one discrepancy job's 72 s. `compile_kernels` calls each kernel
@@ -14,6 +14,7 @@ import time
 import numpy as np
 
 from ..units import G
+from .amplitude import harmonic_balance
 from .elements import cubic_spring, quadratic_damper
 from .envelope import steady_state
 from .iwan import IwanParams
@@ -43,6 +44,8 @@ def compile_kernels() -> float:
     f = np.linspace(1800.0, 2600.0, 40)
     t = np.linspace(0.0, 2.0, 40)
     drive = SweepDrive(t, f, np.full(40, 2.0), 0.02)
+    harmonic_balance(np.geomspace(1e-6, 1e-3, 4), np.array([[313.0], [200.0]]), 1.02e6, -0.65, 0.004, 6.12e5,
+                     2.65 / G, 0.0015)  # the GA's and the posterior's amplitude curves
     for model in _models():
         for direction in ("up", "down"):
             steady_state(model, f, 2.0, direction=direction)

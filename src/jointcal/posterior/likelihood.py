@@ -143,10 +143,21 @@ class LogPosterior:
         log = np.r_[self.space.is_log, True, True]
         return np.where(log, 10.0**x, x)
 
+    @cached_property  # read at every evaluation: computed once
+    def _is_log(self) -> NDArray[np.bool_]:
+        """`space.is_log`, shape (space.ndim,)."""
+        return self.space.is_log
+
+    @cached_property  # read at every evaluation: computed once
+    def _root_w(self) -> NDArray[np.float64] | None:
+        """sqrt of the points' weights, shape (N,), or None when every point weighs 1."""
+        return None if self.data.weight is None else np.sqrt(self.data.w)
+
     def residuals(self, x: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Relative residuals of f and zeta, each (W, N), at GA-space points x (W, space.ndim or ndim)."""
         x = np.atleast_2d(np.asarray(x, dtype=float))
-        theta = self.space.joint(np.where(self.space.is_log, 10.0 ** x[:, :self.space.ndim], x[:, :self.space.ndim]))
+        xs = x[:, :self.space.ndim]
+        theta = np.where(self._is_log, 10.0 ** xs, xs)[:, self.joint]  # the joint's columns (`ParamSpace.joint`)
         with np.errstate(all="ignore"):
             f_m, z_m = predict(theta, self.data.q, m=self.m, model=self.model,
                                viscous=self.viscous)  # type: ignore[arg-type]
@@ -160,16 +171,17 @@ class LogPosterior:
         ok = np.all(np.isfinite(x) & (x >= self.lower) & (x <= self.upper), axis=1)
         if not ok.any():
             return out
-        r_f, r_z = self.residuals(x[ok])
-        s_f, s_z = 10.0 ** x[ok, -2], 10.0 ** x[ok, -1]
+        x_ok = x if ok.all() else x[ok]
+        r_f, r_z = self.residuals(x_ok)
+        s_f, s_z = 10.0 ** x_ok[:, -2], 10.0 ** x_ok[:, -1]
         n = self.data.q.size
-        if self.data.weight is not None:  # each point's Gaussian to the power of its weight
-            w, n = self.data.w, self.data.n_readouts
-            r_f, r_z = r_f * np.sqrt(w), r_z * np.sqrt(w)
+        if self._root_w is not None:  # each point's Gaussian to the power of its weight
+            n = self.data.n_readouts
+            r_f, r_z = r_f * self._root_w, r_z * self._root_w
         with np.errstate(all="ignore"):
             lp = (-0.5 * np.sum(r_f**2, axis=1) / s_f**2 - n * np.log(s_f)
                   - 0.5 * np.sum(r_z**2, axis=1) / s_z**2 - n * np.log(s_z)
-                  - log_det_dy_dx(y[ok][:, self.joint]))  # prior uniform in x -> density 1/(chi+1) in y
+                  - log_det_dy_dx((y if ok.all() else y[ok])[:, self.joint]))  # prior uniform in x -> 1/(chi+1) in y
         out[ok] = np.where(np.isfinite(lp), lp, -np.inf)
         return out
 

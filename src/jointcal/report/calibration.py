@@ -34,6 +34,17 @@ def _figure(width: float, height: float, dpi: float = 110):
     return fig
 
 
+def _lower_triangle(fig, n: int) -> NDArray[np.object_]:
+    """Axes (n, n) of a scatter-plot matrix on and below the diagonal; None above it (never created, which
+    costs as much as drawing: the figure is the same as with `fig.subplots(n, n)` and the upper panels hidden)."""
+    grid = fig.add_gridspec(n, n)
+    axes = np.full((n, n), None, dtype=object)
+    for i in range(n):
+        for j in range(i + 1):
+            axes[i, j] = fig.add_subplot(grid[i, j])
+    return axes
+
+
 def _png(fig) -> bytes:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", metadata={"Software": None})
@@ -135,7 +146,7 @@ def exploration_figure(history: pd.DataFrame, *, title: str = "", max_points: in
     lim = {c: _axis_values(c, np.asarray(bounds[c], dtype=float)) for c in PARAMS if bounds and c in bounds}
     n = len(cols)
     fig = _figure(1.35 * n + 2.2, 1.35 * n, dpi=88)  # <= ~850 px tall: Snakemake's report clips taller images
-    axes = fig.subplots(n, n)
+    axes = _lower_triangle(fig, n)
     sc = None
     for i, ci in enumerate(cols):
         for j, cj in enumerate(cols):
@@ -152,7 +163,6 @@ def exploration_figure(history: pd.DataFrame, *, title: str = "", max_points: in
                     for b in lim[ci]:
                         ax.axhline(b, color="0.5", ls="--", lw=0.8)
             else:
-                ax.set_visible(False)
                 continue
             if cj in lim:
                 ax.set_xlim(*lim[cj])

@@ -10,7 +10,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from .calibration import _POINTS, _figure, _png
+from .calibration import _POINTS, _figure, _lower_triangle, _png
 
 __all__ = ["corner_figure"]
 
@@ -51,7 +51,7 @@ def corner_figure(samples: NDArray[np.float64], names: Sequence[str], *, truth: 
     samples = np.asarray(samples, dtype=float)
     d = samples.shape[1]
     fig = _figure(1.2 * d + 0.4, 1.2 * d, dpi=88)  # <= ~850 px tall: Snakemake's report clips taller images
-    axes = fig.subplots(d, d)
+    axes = _lower_triangle(fig, d)
     ref = np.full(d, np.nan) if truth is None else np.asarray(truth, dtype=float)
     pts = {k: np.asarray(v, dtype=float) for k, v in (points or {}).items()}
     lims = _corner_limits(samples, [ref, *pts.values()])
@@ -60,7 +60,7 @@ def corner_figure(samples: NDArray[np.float64], names: Sequence[str], *, truth: 
     n_modes = 0 if modes is None else int(np.max(modes)) + 1
     styles = {k: _POINTS.get(k, dict(marker="o", color="C2")) for k in pts}
     marks = np.stack([ref, lo_b, hi_b], axis=1)  # per column: truth, lower and upper bound
-    for i, j in ((i, j) for i in range(d) for j in range(d)):
+    for i, j in ((i, j) for i in range(d) for j in range(i + 1)):
         _panel(axes[i, j], samples, (i, j), lims, bins, modes if n_modes > 1 else None, pts, styles, marks,
                names)
     fig.legend(handles=_corner_handles(styles, modes, n_modes, bounds is not None), loc="upper right",
@@ -84,11 +84,8 @@ def _corner_limits(samples: NDArray[np.float64], marks: Sequence[NDArray[np.floa
 def _panel(ax, samples: NDArray[np.float64], where: tuple[int, int], lims: Sequence[tuple[float, float]], bins: int,
            modes: NDArray[np.int_] | None, pts: Mapping[str, NDArray[np.float64]], styles: Mapping[str, dict],
            marks: NDArray[np.float64], names: Sequence[str]) -> None:
-    """Panel (row i, column j): hidden above the diagonal, a marginal on it, a 2-D histogram below it."""
+    """Panel (row i, column j <= i): a marginal on the diagonal, a 2-D histogram below it."""
     i, j = where
-    if j > i:
-        ax.set_visible(False)
-        return
     if i == j:
         _marginal(ax, samples[:, i], lims[i], bins, modes, {k: v[i] for k, v in pts.items()}, styles)
     else:
