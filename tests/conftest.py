@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
-from _campaign import DEFAULT_SPEC, SMALL_CAMPAIGN, voltage_campaign
-from _modal_helpers import modal_table
+from tests._support.campaign import DEFAULT_SPEC, SMALL_CAMPAIGN, voltage_campaign
+from tests._support.modal_helpers import modal_table
 
 from jointcal.synth import generate
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import _rigs
+from tests._support import rigs as _rigs
 
 
 @pytest.mark.parametrize("ref, eta, direction", [("voltage", 5.0, "up"), ("force", 500.0, "down"),

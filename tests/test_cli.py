@@ -6,7 +6,7 @@ import sys
 
 import pandas as pd
 import pytest
-from _campaign import edit_run
+from tests._support.campaign import edit_run
 
 from jointcal import __version__
 from jointcal.cli import main

@@ -8,8 +8,8 @@ import json
 import numpy as np
 import pandas as pd
 import pytest
-from _microslip import M, PARAMS, TRUTH, null_draws, readouts
-from _modal_tables import modal_tables
+from tests._support.microslip import M, PARAMS, TRUTH, null_draws, readouts
+from tests._support.modal_tables import modal_tables
 
 from jointcal.calibrate import CalibrateSettings
 from jointcal.design import DesignSettings, candidates, level_series, narrowing, rank, readout, run_design

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from _kinds_records import FN, ZETA, linear_dwell, linear_frf
+from tests._support.kinds_records import FN, ZETA, linear_dwell, linear_frf
 
 from jointcal.measure.dwell import dwell_mode, dwell_point
 from jointcal.models import IwanParams, MinistackModel, harmonic_balance, simulate

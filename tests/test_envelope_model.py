@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 from scipy.signal import fftconvolve
 
-from _lockin import linear_sweep
+from tests._support.lockin import linear_sweep
 from jointcal.models.envelope import _structure_terms
 from jointcal.models import (
     G, Fixture, IwanParams, MinistackModel, cubic_spring, dissipation, harmonic_balance, simulate, steady_state,

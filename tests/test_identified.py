@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from _microslip import M, PARAMS, TRUTH, model_readouts, null_draws, readouts
+from tests._support.microslip import M, PARAMS, TRUTH, model_readouts, null_draws, readouts
 
 from jointcal.calibrate import CalibrateSettings
 from jointcal.posterior.identified import fisher, fixed_directions, free_share, identified_at, identified_table

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from _campaign import REPO, edit_manifest, edit_run, workflow_copy
+from tests._support.campaign import REPO, edit_manifest, edit_run, workflow_copy
 from scipy import signal
 
 from jointcal.calibrate.data import select_modal

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 import scipy.io
-from _campaign import DATA, edit_manifest, edit_run
+from tests._support.campaign import DATA, edit_manifest, edit_run
 
 from jointcal.io._clipping import clip_levels
 from jointcal.io import (

@@ -4,8 +4,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 import pytest
-from _campaign import EXAMPLE, example_copy, edit_manifest
-from _kinds_records import dwell_row, kinds_campaign, linear_dwell
+from tests._support.campaign import EXAMPLE, example_copy, edit_manifest
+from tests._support.kinds_records import dwell_row, kinds_campaign, linear_dwell
 
 from jointcal.io import CampaignError, ingest_campaign, read_manifest, read_run
 
@@ -98,7 +98,7 @@ def test_sweeps_are_the_default_and_read_as_before(tmp_path, test):
 
 def _testlab_pair(folder, rid, rec):
     """A run exported as Test.Lab does it: the response in <rid>_Time.mat, the drive apart in <rid>_TimeShaker.mat."""
-    from test_lab_formats import write_testlab
+    from tests.test_lab_formats import write_testlab
 
     folder.mkdir(parents=True, exist_ok=True)
     write_testlab(folder / f"{rid}_Time.mat", rec[["time_s", "response_accel_g"]], {"response_accel_g": "g"})
@@ -106,7 +106,7 @@ def _testlab_pair(folder, rid, rec):
 
 
 def test_a_drive_exported_apart_is_read_from_reference_file(tmp_path, records):
-    from test_lab_formats import NAMES
+    from tests.test_lab_formats import NAMES
 
     lab = tmp_path / "lab"
     for rid, rec in (("d18", "d18"), ("d20", "d20"), ("r20", "d20")):

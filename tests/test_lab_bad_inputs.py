@@ -12,9 +12,9 @@ import pandas as pd
 import pytest
 import pyuff
 import scipy.io
-from _campaign import REPO, example_copy
+from tests._support.campaign import REPO, example_copy
 from nptdms import ChannelObject, GroupObject, TdmsWriter
-from test_lab_units import DIMS, REAL, _as_lab_run, _quantity, write_testlab_mks, write_uff_units
+from tests.test_lab_units import DIMS, REAL, _as_lab_run, _quantity, write_testlab_mks, write_uff_units
 
 from jointcal.cli import main
 from jointcal.io import CampaignWarning, UNUSABLE_FLAGS, read_manifest, read_run

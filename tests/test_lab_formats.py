@@ -11,7 +11,7 @@ import pandas as pd
 import pytest
 import pyuff
 import scipy.io
-from _campaign import edit_manifest, example_copy
+from tests._support.campaign import edit_manifest, example_copy
 from nptdms import ChannelObject, GroupObject, TdmsWriter
 
 from jointcal.io import CampaignError, ingest_campaign, read_manifest, read_run
@@ -266,7 +266,7 @@ def test_workflow_reads_lab_exports_as_it_reads_the_csv(tmp_path, voltage_source
     import subprocess
     import sys
 
-    from _campaign import workflow_copy
+    from tests._support.campaign import workflow_copy
 
     lab = Path(shutil.copytree(voltage_source, tmp_path / "lab"))
     man = read_manifest(lab / "manifest.csv")

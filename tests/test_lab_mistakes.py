@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 import pytest
 import scipy.io
-from _campaign import REPO, edit_manifest, edit_run, example_copy, workflow_copy
+from tests._support.campaign import REPO, edit_manifest, edit_run, example_copy, workflow_copy
 
 from jointcal.cli import main
 from jointcal.io import CampaignError, CampaignWarning, ingest_campaign, read_manifest, read_run, validate_run

@@ -13,7 +13,7 @@ import pandas as pd
 import pytest
 import pyuff
 import scipy.io
-from _campaign import REPO, edit_manifest
+from tests._support.campaign import REPO, edit_manifest
 
 from jointcal.io import CampaignError, ingest_campaign, read_manifest, read_run
 from jointcal.io._lab_channels import lab_channels
@@ -190,7 +190,7 @@ def test_a_uff_response_said_only_by_its_exponents_and_data_set_164_is_read_righ
 def test_a_base_driven_uff_in_si_said_only_by_exponents_and_data_set_164_is_read_right(tmp_path):
     """Both accelerations in m/s^2 (length exponent 1, data set 164 SI, no label): formerly read as g, 9.81x, and
     caught only by the level check; now the CSV's g, no flag."""
-    from _campaign import example_copy
+    from tests._support.campaign import example_copy
 
     campaign = example_copy(tmp_path / "c", "first_01_1g_up", "first_07_2g_up")
     row = read_manifest(campaign / "manifest.csv").iloc[0].to_dict()

@@ -5,7 +5,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from _modal_helpers import against_truth, modal_table
+from tests._support.modal_helpers import against_truth, modal_table
 from jointcal.io import write_run
 from jointcal.measure.envelopes import envelopes
 from jointcal.measure.modal import modal_properties
@@ -129,7 +129,7 @@ def test_bad_runs_inside_a_valid_campaign_are_flagged_and_the_rest_finish(tmp_pa
     import subprocess
     import sys
 
-    from _campaign import workflow_copy
+    from tests._support.campaign import workflow_copy
 
     base = {"seed": 9, "sweep": {"f_start_hz": 1500.0, "f_stop_hz": 2700.0, "rate_hz_per_s": 400.0},
             "series": [{"level_g": 1.0, "directions": ["up", "down"]}], "assemblies": {"first": FIRST}}
@@ -248,7 +248,7 @@ def test_a_run_is_read_with_the_config_modal_section_as_the_later_stages_pass_it
     (measure_run): its campaign-level switches (coil, on or off) do not reach the one-run read-out, which
     gives the same numbers as without them."""
     import yaml
-    from _campaign import REPO, voltage_campaign
+    from tests._support.campaign import REPO, voltage_campaign
 
     from jointcal.io import read_manifest, read_run
     from jointcal.measure.modal import measure_run

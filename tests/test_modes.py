@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 import pytest
-from _two_modes import campaign, truth
+from tests._support.two_modes import campaign, truth
 
 from jointcal._workflow import modal_units
 from jointcal.io import read_manifest, read_run
@@ -103,7 +103,7 @@ def test_a_voltage_driven_chirp_over_two_modes_reads_each(tmp_path):
     mode at 230 Hz), chirped over both modes at eta 50 with 2% noise: both modes found in every run; the
     jointed one on the coupled rig's pole at its q_in (0.1%, 5%), the linear one at one frequency and
     damping whatever the level."""
-    import _rigs
+    from tests._support import rigs as _rigs
 
     from jointcal.synth import generate
 

@@ -9,8 +9,8 @@ import numpy as np
 import pandas as pd
 import pytest
 import yaml
-from _campaign import REPO
-from _modal_tables import TABLE_3_2, modal_tables, write_tables
+from tests._support.campaign import REPO
+from tests._support.modal_tables import TABLE_3_2, modal_tables, write_tables
 
 from jointcal.calibrate import PARAMS, CalibrateSettings, CalibrationInputError, run_calibration, select_modal
 from jointcal.models import harmonic_balance

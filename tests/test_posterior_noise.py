@@ -11,7 +11,7 @@ from dataclasses import replace
 import numpy as np
 import pandas as pd
 import pytest
-from _microslip import M, PARAMS, TRUTH, readouts
+from tests._support.microslip import M, PARAMS, TRUTH, readouts
 
 from jointcal.calibrate import CalibrateSettings
 from jointcal.calibrate.data import ModalData

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from _modal_tables import TABLE_3_2, modal_tables
+from tests._support.modal_tables import TABLE_3_2, modal_tables
 
 from jointcal.calibrate import CalibrateSettings, objective, read_modal, run_calibration, select_modal
 from jointcal.io import ingest_campaign, read_run, write_csv_atomic

@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from _campaign import workflow_copy
+from tests._support.campaign import workflow_copy
 from jointcal.calibrate import DEFAULT_BOUNDS
 from jointcal.posterior.fit import P_REJECT
 from jointcal.report.summary import fmt

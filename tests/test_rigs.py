@@ -222,7 +222,7 @@ def test_workflow_reads_a_voltage_driven_chirp_campaign(tmp_path):
     import sys
 
     import pandas as pd
-    from _campaign import workflow_copy
+    from tests._support.campaign import workflow_copy
 
     spec = {"seed": 8, "sample_rate_hz": 1024.0, "sweep": {"f_start_hz": 70.0, "f_stop_hz": 130.0,
                                                            "rate_hz_per_s": 20.0 * (97.66 * 0.0192) ** 2,

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad_vec
 
-from _lockin import demodulate, linear_sweep, quadrature
+from tests._support.lockin import demodulate, linear_sweep, quadrature
 from jointcal.models import G, Fixture, IwanParams, MinistackModel, harmonic_balance, qsma
 from jointcal.models import contact_spring, resonance_amplitude, simulate
 from jointcal.models.simulate import fractional_delay, hermite_propagator

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from _jacobian import assert_matches_central_difference
+from tests._support.jacobian import assert_matches_central_difference
 from jointcal.measure.sweepfit import fit_swept_mode
 from jointcal.models import G, IwanParams, MinistackModel, harmonic_balance, simulate
 from jointcal.synth.daq import controlled_sweep

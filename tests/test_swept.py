@@ -8,7 +8,7 @@ the exact-Iwan time simulation (`simulate`) demodulated by an independent Hann l
 import numpy as np
 import pytest
 
-from _lockin import linear_sweep
+from tests._support.lockin import linear_sweep
 from jointcal.models import (
     G, Fixture, IwanParams, MinistackModel, SweepDrive, quasi_steady, simulate, steady_state, swept_transmissibility,
 )

@@ -5,7 +5,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from _lockin import run_amplitudes, run_quadrature
+from tests._support.lockin import run_amplitudes, run_quadrature
 from jointcal.io import ingest_campaign, read_manifest, read_run
 from jointcal.models import G, MinistackModel
 from jointcal.models.structure import state_space

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 import pytest
-from _kinds_records import FN, ZETA, dwell_row, kinds_campaign, linear_dwell
+from tests._support.kinds_records import FN, ZETA, dwell_row, kinds_campaign, linear_dwell
 
 from jointcal.io import ingest_campaign, read_run
 from jointcal.measure.campaign import campaign_modal

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from _modal_helpers import modal_table
+from tests._support.modal_helpers import modal_table
 
 from jointcal.calibrate import CalibrateSettings, run_calibration
 from jointcal.io import read_manifest, read_run, write_csv_atomic

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 import yaml
-from _campaign import REPO, edit_run, workflow_copy, unit
+from tests._support.campaign import REPO, edit_run, workflow_copy, unit
 
 pytestmark = pytest.mark.slow
 

@@ -16,8 +16,8 @@ import numpy as np
 import pandas as pd
 import pytest
 import yaml
-from _campaign import REPO, unit
-from _modal_tables import M, TABLE_3_2, write_tables
+from tests._support.campaign import REPO, unit
+from tests._support.modal_tables import M, TABLE_3_2, write_tables
 
 from jointcal.models import harmonic_balance
 

@@ -17,8 +17,8 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
-from _campaign import REPO, SMALL_CAMPAIGN, edit_manifest
-from _modal_tables import TABLE_3_2, modal_tables, write_tables
+from tests._support.campaign import REPO, SMALL_CAMPAIGN, edit_manifest
+from tests._support.modal_tables import TABLE_3_2, modal_tables, write_tables
 
 from jointcal import _workflow
 from jointcal._workflow import campaign_index, config_problem, pending_outputs, stage_sources

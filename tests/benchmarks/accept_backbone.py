@@ -23,8 +23,8 @@ from pathlib import Path
 
 import pandas as pd
 
-sys.path.insert(0, str(Path(__file__).parents[1]))
-import _rigs  # noqa: E402
+sys.path.insert(0, str(Path(__file__).parents[2]))
+from tests._support import rigs as _rigs  # noqa: E402
 
 ETAS = (0.5, 5.0, 50.0, 500.0)
 

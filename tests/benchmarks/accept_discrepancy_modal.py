@@ -48,8 +48,8 @@ from pathlib import Path
 import pandas as pd
 import yaml
 
-sys.path.insert(0, str(Path(__file__).parents[1]))
-from _rigs import JOINTED_BEAM, SECOND_MODE, SMALL_SHAKER, levels_V, truth_curve  # noqa: E402
+sys.path.insert(0, str(Path(__file__).parents[2]))
+from tests._support.rigs import JOINTED_BEAM, SECOND_MODE, SMALL_SHAKER, levels_V, truth_curve  # noqa: E402
 
 from jointcal.calibrate import CalibrateSettings, run_calibration  # noqa: E402
 from jointcal.discrepancy import DiscrepancySettings, diagnose  # noqa: E402

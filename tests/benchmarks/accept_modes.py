@@ -22,10 +22,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-HERE = Path(__file__).parents[1]
+HERE = Path(__file__).parents[2]
 sys.path.insert(0, str(HERE))
-import _two_modes  # noqa: E402
-from _campaign import workflow_copy  # noqa: E402
+from tests._support import two_modes as _two_modes  # noqa: E402
+from tests._support.campaign import workflow_copy  # noqa: E402
 
 TRUTH_OF = {"m99": "low", "m227": "high", "m226": "high"}
 

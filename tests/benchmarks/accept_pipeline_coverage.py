@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from _modal_helpers import modal_table  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+from tests._support.modal_helpers import modal_table  # noqa: E402
 from jointcal.calibrate import CalibrateSettings, run_calibration  # noqa: E402
 from jointcal.io import write_csv_atomic  # noqa: E402
 from jointcal.measure.scatter import scatter  # noqa: E402

@@ -36,8 +36,8 @@ from jointcal.io import read_manifest, read_run  # noqa: E402
 from jointcal.measure.modal import measure_run  # noqa: E402
 from jointcal.measure.sweepfit import fit_swept_mode  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).parents[1]))
-import _rigs  # noqa: E402
+sys.path.insert(0, str(Path(__file__).parents[2]))
+from tests._support import rigs as _rigs  # noqa: E402
 
 SCHEMES = ("2-point", "sensitivity")
 

@@ -9,9 +9,9 @@ import pandas as pd
 
 from jointcal.io import read_run
 
-DATA = Path(__file__).parent / "data"
+DATA = Path(__file__).parents[1] / "data"
 SMALL_CAMPAIGN = DATA / "small_campaign"
-REPO = Path(__file__).parents[1]
+REPO = Path(__file__).parents[2]
 EXAMPLE = REPO / "raw_data"
 # the default generator (no hidden effect) with the seed the session's default campaign is made with (conftest.py)
 DEFAULT_SPEC = {"seed": 7}
