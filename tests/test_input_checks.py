@@ -12,7 +12,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from tests._support.campaign import REPO, edit_manifest, edit_run, workflow_copy
+from tests._support.campaign import REPO, edit_manifest, edit_run
+from tests._support.workflow import snakemake, workflow_copy
 from scipy import signal
 
 from jointcal.calibrate.data import select_modal
@@ -321,22 +322,13 @@ def test_malformed_synth_spec_is_one_sentence(tmp_path, capsys, text, words):
 # ------------------------------------------------------------------------ workflow
 
 
-def _workdir(tmp_path: Path) -> Path:
-    return workflow_copy(tmp_path)
-
-
-def _snakemake(work: Path, *args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", *args], cwd=work, capture_output=True,
-                          text=True, timeout=600)
-
-
 @pytest.mark.slow
 def test_workflow_keeps_the_nan_warning_when_an_error_follows(tmp_path, campaign):
     edit_run(campaign, "run01.csv.gz", _set("base_accel_g", np.nan))
     edit_manifest(campaign, lambda m: m.assign(sample_rate_hz=m["sample_rate_hz"].where(m["run_id"] != "run04",
                                                                                           "12700")))
     out = tmp_path / "results"
-    res = _snakemake(_workdir(tmp_path), "ingest", "--config", f"raw_data={campaign}", f"results={out}")
+    res = snakemake(workflow_copy(tmp_path), "--cores", "2", "ingest", "--config", f"raw_data={campaign}", f"results={out}")
     assert res.returncode != 0
     log = (out / "logs" / "ingest.log").read_text().splitlines()
     assert len(log) == 2 and "run01.csv.gz: column 'base_accel_g' has 9600 NaN/inf values" in log[0]
@@ -358,7 +350,7 @@ def test_workflow_keeps_a_units_mistake_out_of_the_modal_fit(tmp_path, campaign)
         edit_manifest(campaign, lambda m, r=rid, f=folder: m.assign(
             file=m["file"].where(m["run_id"] != r, f"{f}/run.csv.gz")))
     out = tmp_path / "results"
-    res = _snakemake(_workdir(tmp_path), str(out / "modal" / "modal_properties.csv"),
+    res = snakemake(workflow_copy(tmp_path), "--cores", "2", str(out / "modal" / "modal_properties.csv"),
                      "--config", f"raw_data={campaign}", f"results={out}")
     assert res.returncode == 0, res.stderr
     assert "b/run.csv.gz: base amplitude is 19.6 g" in (out / "logs" / "ingest.log").read_text()

@@ -263,10 +263,8 @@ def test_workflow_reads_lab_exports_as_it_reads_the_csv(tmp_path, voltage_source
     """The voltage campaign with one run as TDMS and the other as a Test.Lab struct: the workflow's modal
     table is the CSV campaign's (every stage reads the record with its manifest row)."""
     import shutil
-    import subprocess
-    import sys
 
-    from tests._support.campaign import workflow_copy
+    from tests._support.workflow import snakemake, workflow_copy
 
     lab = Path(shutil.copytree(voltage_source, tmp_path / "lab"))
     man = read_manifest(lab / "manifest.csv")
@@ -280,9 +278,8 @@ def test_workflow_reads_lab_exports_as_it_reads_the_csv(tmp_path, voltage_source
     for name, campaign in (("csv", voltage_source), ("lab", lab)):
         out = tmp_path / f"results_{name}"
         (tmp_path / f"wf_{name}").mkdir()
-        res = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", "modal_properties", "--config",
-                              f"raw_data={campaign}", f"results={out}"], cwd=workflow_copy(tmp_path / f"wf_{name}"),
-                             capture_output=True, text=True, timeout=900)
+        res = snakemake(workflow_copy(tmp_path / f"wf_{name}"), "--cores", "2", "modal_properties", "--config",
+                        f"raw_data={campaign}", f"results={out}")
         assert res.returncode == 0, res.stderr[-3000:]
         tables[name] = pd.read_csv(out / "modal" / "modal_properties.csv", keep_default_na=False)
     assert (tables["lab"]["f_res_method"] == "sweep_fit").all()

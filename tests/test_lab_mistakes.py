@@ -9,8 +9,6 @@ modal stage's 'unusable').
 """
 from __future__ import annotations
 
-import subprocess
-import sys
 import warnings
 import zipfile
 from pathlib import Path
@@ -19,7 +17,8 @@ import numpy as np
 import pandas as pd
 import pytest
 import scipy.io
-from tests._support.campaign import REPO, edit_manifest, edit_run, example_copy, workflow_copy
+from tests._support.campaign import REPO, edit_manifest, edit_run, example_copy
+from tests._support.workflow import snakemake, workflow_copy
 
 from jointcal.cli import main
 from jointcal.io import CampaignError, CampaignWarning, ingest_campaign, read_manifest, read_run, validate_run
@@ -458,11 +457,6 @@ def test_a_silent_pre_trigger_head_is_named_and_sweep_start_s_reads_the_run(exam
 # ------------------------------------------------------------------------ the workflow
 
 
-def _snakemake(work: Path, *args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", *args], cwd=work, capture_output=True,
-                          text=True, timeout=900)
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize("case", ["windows path", "missing file"])
 def test_workflow_names_a_windows_path_or_a_missing_file_before_looking_for_inputs(tmp_path, example, case):
@@ -473,7 +467,7 @@ def test_workflow_names_a_windows_path_or_a_missing_file_before_looking_for_inpu
         (example / FILE).unlink()
         words = f"{FILE}: the file of run '{RUN}' listed in manifest.csv (line 2) does not exist"
     out = tmp_path / "results"
-    res = _snakemake(workflow_copy(tmp_path), "ingest", "--config", f"raw_data={example}", f"results={out}")
+    res = snakemake(workflow_copy(tmp_path), "--cores", "2", "ingest", "--config", f"raw_data={example}", f"results={out}")
     assert res.returncode != 0
     assert "MissingInputException" not in res.stderr and "Traceback" not in res.stderr, res.stderr
     assert f"jointcal: {example / 'manifest.csv'}" in res.stderr or f"jointcal: {example / FILE}" in res.stderr
@@ -490,7 +484,7 @@ def test_workflow_keeps_a_response_units_mistake_out_of_the_calibration(tmp_path
 
     edit_run(example, FILE, _scale("response_accel_g", G_SI))
     out = tmp_path / "results"
-    res = _snakemake(workflow_copy(tmp_path), str(out / "modal" / "modal_properties.csv"),
+    res = snakemake(workflow_copy(tmp_path), "--cores", "2", str(out / "modal" / "modal_properties.csv"),
                      "--config", f"raw_data={example}", f"results={out}")
     assert res.returncode == 0, res.stderr[-3000:]
     assert f"{FILE}: below resonance" in (out / "logs" / "ingest.log").read_text()

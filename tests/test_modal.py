@@ -126,10 +126,7 @@ def _merge_run(dst: Path, src: Path, run_id: str, new_id: str, sequence: int) ->
 
 def test_bad_runs_inside_a_valid_campaign_are_flagged_and_the_rest_finish(tmp_path):
     """Workflow: a band that misses the resonance, a clipped response, a NaN burst."""
-    import subprocess
-    import sys
-
-    from tests._support.campaign import workflow_copy
+    from tests._support.workflow import snakemake, workflow_copy
 
     base = {"seed": 9, "sweep": {"f_start_hz": 1500.0, "f_stop_hz": 2700.0, "rate_hz_per_s": 400.0},
             "series": [{"level_g": 1.0, "directions": ["up", "down"]}], "assemblies": {"first": FIRST}}
@@ -147,9 +144,7 @@ def test_bad_runs_inside_a_valid_campaign_are_flagged_and_the_rest_finish(tmp_pa
     write_run(nanfile, df["time_s"], df["base_accel_g"], df["response_accel_g"])
     work = workflow_copy(tmp_path)
     out = tmp_path / "results"
-    res = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", "modal", "--config",
-                          f"raw_data={tmp_path / 'c'}", f"results={out}"], cwd=work, capture_output=True,
-                         text=True, timeout=600)
+    res = snakemake(work, "--cores", "2", "modal", "--config", f"raw_data={tmp_path / 'c'}", f"results={out}")
     assert res.returncode == 0, res.stderr[-3000:]
     t = pd.read_csv(out / "modal" / "modal_properties.csv", dtype={"flags": str}).set_index("run_id")
     t["flags"] = t["flags"].fillna("")

@@ -11,15 +11,13 @@ from __future__ import annotations
 
 import json
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from tests._support.campaign import workflow_copy
+from tests._support.workflow import snakemake, workflow_copy
 from jointcal.calibrate import DEFAULT_BOUNDS
 from jointcal.posterior.fit import P_REJECT
 from jointcal.report.summary import fmt
@@ -34,8 +32,7 @@ pytestmark = [pytest.mark.acceptance,
 
 def test_a_voltage_driven_real_campaign_runs_end_to_end_with_the_default_config(tmp_path):
     work, out = workflow_copy(tmp_path), tmp_path / "results"
-    res = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", "--config", f"raw_data={REAL}",
-                          f"results={out}"], cwd=work, capture_output=True, text=True, timeout=1800)
+    res = snakemake(work, "--cores", "2", "--config", f"raw_data={REAL}", f"results={out}")
     assert res.returncode == 0, res.stderr[-3000:]
     best = json.loads((out / "calibration" / "bert_5Nm" / "m18" / "ga_best.json").read_text())
     assert best["model_kind"] == "modal" and best["excitation"] == "voltage" and best["per_unit_modal_mass"]

@@ -218,11 +218,8 @@ def test_workflow_reads_a_voltage_driven_chirp_campaign(tmp_path):
     ingest takes level_V / drive_V, the modal stage reads the rig's pole (swept-mode fit; pair backbone
     and FRF fit beside it), each
     run's FRF is written."""
-    import subprocess
-    import sys
-
     import pandas as pd
-    from tests._support.campaign import workflow_copy
+    from tests._support.workflow import snakemake, workflow_copy
 
     spec = {"seed": 8, "sample_rate_hz": 1024.0, "sweep": {"f_start_hz": 70.0, "f_stop_hz": 130.0,
                                                            "rate_hz_per_s": 20.0 * (97.66 * 0.0192) ** 2,
@@ -233,9 +230,8 @@ def test_workflow_reads_a_voltage_driven_chirp_campaign(tmp_path):
     truth = json.loads((tmp_path / "t.json").read_text())["runs"]
     work = workflow_copy(tmp_path)
     out = tmp_path / "results"
-    res = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", "modal_properties", "--config",
-                          f"raw_data={tmp_path / 'c'}", f"results={out}"], cwd=work, capture_output=True,
-                         text=True, timeout=600)
+    res = snakemake(work, "--cores", "2", "modal_properties", "--config", f"raw_data={tmp_path / 'c'}",
+                    f"results={out}")
     assert res.returncode == 0, res.stderr[-3000:]
     t = pd.read_csv(out / "modal" / "modal_properties.csv", dtype={"flags": str})
     assert (t["f_res_method"] == "sweep_fit").all() and "level_V" in t.columns

@@ -4,14 +4,14 @@ from __future__ import annotations
 import json
 import re
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 import yaml
-from tests._support.campaign import REPO, edit_run, workflow_copy, unit
+from tests._support.campaign import REPO, edit_run, unit
+from tests._support.workflow import snakemake, workflow_copy
 
 pytestmark = pytest.mark.slow
 
@@ -20,11 +20,6 @@ pytestmark = pytest.mark.slow
 def workdir(tmp_path: Path) -> Path:
     """A copy of Snakefile, workflow/ and profiles/ (the working directory of each run)."""
     return workflow_copy(tmp_path)
-
-
-def _snakemake(work: Path, *args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "snakemake", *args], cwd=work, capture_output=True, text=True,
-                          timeout=900)
 
 
 # light settings: these tests check the wiring and the reruns; test_calibrate, test_posterior, test_validate and
@@ -42,14 +37,14 @@ def small_run(tmp_path_factory, small_campaign) -> tuple[Path, Path, subprocess.
     work = workflow_copy(tmp)
     (work / "small.yaml").write_text(yaml.safe_dump(SMALL))
     out = tmp / "results"
-    res = _snakemake(work, "validate", "--configfile", "small.yaml", "--config", f"raw_data={small_campaign}",
+    res = snakemake(work, "validate", "--configfile", "small.yaml", "--config", f"raw_data={small_campaign}",
                      f"results={out}")
     return work, out, res
 
 
 def _again(small_run, small_campaign, *args: str) -> subprocess.CompletedProcess[str]:
     work, out, _ = small_run
-    return _snakemake(work, "--cores", "2", *args, "--configfile", "small.yaml", "--config",
+    return snakemake(work, "--cores", "2", *args, "--configfile", "small.yaml", "--config",
                       f"raw_data={small_campaign}", f"results={out}")
 
 
@@ -113,7 +108,7 @@ def test_discrepancy_target_runs_that_stage_alone_on_top(small_run, small_campai
 def test_malformed_campaign_fails_naming_the_file(workdir, tmp_path, campaign):
     edit_run(campaign, "run03.csv.gz", lambda d: d.rename(columns={"response_accel_g": "resp_g"}))
     out = tmp_path / "results"
-    res = _snakemake(workdir, "--cores", "2", "ingest", "--config", f"raw_data={campaign}", f"results={out}")
+    res = snakemake(workdir, "--cores", "2", "ingest", "--config", f"raw_data={campaign}", f"results={out}")
     assert res.returncode != 0
     assert "run03.csv.gz: column 'response_accel_g' is missing" in res.stderr
     assert "run03.csv.gz" in (out / "logs" / "ingest.log").read_text()
@@ -121,14 +116,14 @@ def test_malformed_campaign_fails_naming_the_file(workdir, tmp_path, campaign):
 
 
 def test_missing_manifest_is_one_clear_line(workdir, tmp_path):
-    res = _snakemake(workdir, "-n", "--cores", "2", "--config", f"raw_data={tmp_path / 'nowhere'}")
+    res = snakemake(workdir, "-n", "--cores", "2", "--config", f"raw_data={tmp_path / 'nowhere'}")
     assert res.returncode != 0
     assert "nowhere/manifest.csv: the campaign manifest does not exist" in res.stderr
     assert "Traceback" not in res.stderr and "File " not in res.stderr
 
 
 def test_lint_reports_only_the_expected_conda_advice(workdir, small_campaign, tmp_path):
-    res = _snakemake(workdir, "--lint", "--config", f"raw_data={small_campaign}", f"results={tmp_path / 'r'}")
+    res = snakemake(workdir, "--lint", "--config", f"raw_data={small_campaign}", f"results={tmp_path / 'r'}")
     items = [line.strip() for line in (res.stdout + res.stderr).splitlines() if line.strip().startswith("* ")]
     assert items, res.stdout + res.stderr  # snakemake --lint always asks for conda (STYLE.md trap 4)
     assert set(items) == {"* Specify a conda environment or container for each rule.:"}, res.stdout + res.stderr
@@ -144,7 +139,7 @@ def test_default_config_runs_on_the_example_campaign(workdir, tmp_path):
     (workdir / "short.yaml").write_text("posterior: {max_steps: 2000, chunk: 500}\nvalidate: {n_draws: 2}\n"
                                         "discrepancy: {candidates: [sensor_gain, channel_delay, fixture_flexibility], "
                                         "max_nfev: 15, ga_generations: 5, posterior_steps: 200}\n")
-    res = _snakemake(workdir, "--cores", "2", "--configfile", "short.yaml", "--config", f"results={out}")
+    res = snakemake(workdir, "--cores", "2", "--configfile", "short.yaml", "--config", f"results={out}")
     assert res.returncode == 0, res.stderr
     runs = pd.read_csv(out / "ingest" / "runs.csv")
     assert len(runs) == 24 and runs["flags"].isna().all()

@@ -8,8 +8,6 @@ from __future__ import annotations
 
 import json
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +16,7 @@ import pytest
 import yaml
 from tests._support.campaign import REPO, unit
 from tests._support.modal_tables import M, TABLE_3_2, write_tables
+from tests._support.workflow import snakemake
 
 from jointcal.models import harmonic_balance
 
@@ -62,13 +61,8 @@ def workdir(tmp_path: Path) -> Path:
     return work
 
 
-def _snakemake(work: Path, *args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", *args, *SMALL], cwd=work,
-                          capture_output=True, text=True, timeout=600)
-
-
 def test_calibrate_then_posterior_then_nothing_to_do_until_the_config_changes(workdir):
-    res = _snakemake(workdir, "calibrate")
+    res = snakemake(workdir, "--cores", "2", "calibrate", *SMALL)
     assert res.returncode == 0, res.stderr
     out = workdir / "results"
     for a in TABLE_3_2:
@@ -76,7 +70,7 @@ def test_calibrate_then_posterior_then_nothing_to_do_until_the_config_changes(wo
         assert (out / "figures" / f"ga_exploration_{a}_{unit(out, a)}.png").stat().st_size > 10_000
         assert "calibrated" in (out / "logs" / "calibrate" / a / f"{unit(out, a)}.log").read_text()
     assert not (out / "posterior").exists()  # `calibrate` runs only what it needs
-    res = _snakemake(workdir, "posterior", "summary")
+    res = snakemake(workdir, "--cores", "2", "posterior", "summary", *SMALL)
     assert res.returncode == 0, res.stderr
     assert "calibrate_assembly" not in res.stderr  # the GA is not rerun
     for a in TABLE_3_2:
@@ -88,14 +82,14 @@ def test_calibrate_then_posterior_then_nothing_to_do_until_the_config_changes(wo
     assert "| first | GA optimum (one member of the posterior's set) |" in md and "not identified (spans" in md
     qvh = pd.read_csv(out / "posterior" / "qsma_vs_harmonic_balance.csv")
     assert (qvh["df_percent"] > 0).all()  # QSMA sits above harmonic balance
-    res = _snakemake(workdir, "-n", "posterior", "summary")
+    res = snakemake(workdir, "--cores", "2", "-n", "posterior", "summary", *SMALL)
     assert res.returncode == 0 and "Nothing to be done" in res.stdout + res.stderr
     small = yaml.safe_load((workdir / "small.yaml").read_text())
     small["calibrate"]["eta"] = 0.9
     (workdir / "small.yaml").write_text(yaml.safe_dump(small))
-    res = _snakemake(workdir, "-n", "posterior")  # a config edit reruns the GA and what follows
+    res = snakemake(workdir, "--cores", "2", "-n", "posterior", *SMALL)  # a config edit reruns the GA and what follows
     assert res.returncode == 0 and "calibrate_assembly" in res.stdout + res.stderr
-    res = _snakemake(workdir, "--report", str(workdir / "report.html"))
+    res = snakemake(workdir, "--cores", "2", "--report", str(workdir / "report.html"), *SMALL)
     assert res.returncode == 0, res.stderr
     html = (workdir / "report.html").read_text()
     assert (workdir / "report.html").stat().st_size > 100_000
@@ -128,7 +122,7 @@ def test_the_unit_rules_pass_a_ring_downs_windows_from_backbone_csv_to_calibrate
     windows = pd.DataFrame({"run_id": "first_rd", "mode": mode, "test": "ringdown", "q_in": q, "f_hz": f, "zeta": z})
     pd.concat([backbone, windows], ignore_index=True).to_csv(out / "modal" / "backbone.csv", index=False)
     target = f"results/posterior/first/{mode}/summary.csv"
-    res = _snakemake(workdir, target)
+    res = snakemake(workdir, "--cores", "2", target, *SMALL)
     assert res.returncode == 0, res.stderr
     unit_bb = pd.read_csv(out / "modal" / "first" / mode / "backbone.csv")
     assert (unit_bb["run_id"] == "first_rd").sum() == 20 and len(unit_bb) == 12 + 20
@@ -145,7 +139,7 @@ def test_bad_input_is_one_sentence_naming_the_file(workdir):
     df.loc[df["assembly"] == "first", "flags"] = "unusable"
     df.to_csv(modal, index=False)
     mode = unit(workdir / "results", "first")
-    res = _snakemake(workdir, f"results/calibration/first/{mode}/ga_best.json")  # that GA alone: not the other's too
+    res = snakemake(workdir, "--cores", "2", f"results/calibration/first/{mode}/ga_best.json", *SMALL)  # that GA alone: not the other's too
     assert res.returncode != 0
     assert (f"results/modal/first/{mode}/modal_properties.csv: all 12 runs of assembly 'first' are flagged unusable"
             in res.stderr), res.stderr
@@ -153,7 +147,6 @@ def test_bad_input_is_one_sentence_naming_the_file(workdir):
 
 
 def test_lint_reports_only_the_expected_conda_advice(workdir):
-    res = subprocess.run([sys.executable, "-m", "snakemake", "--lint"], cwd=workdir, capture_output=True, text=True,
-                         timeout=300)
+    res = snakemake(workdir, "--lint")
     items = [line.strip() for line in (res.stdout + res.stderr).splitlines() if line.strip().startswith("* ")]
     assert set(items) <= {"* Specify a conda environment or container for each rule.:"}, res.stdout + res.stderr

@@ -12,13 +12,13 @@ import os
 import re
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import pandas as pd
 import pytest
 from tests._support.campaign import REPO, SMALL_CAMPAIGN, edit_manifest
 from tests._support.modal_tables import TABLE_3_2, modal_tables, write_tables
+from tests._support.workflow import snakemake, workflow_copy
 
 from jointcal import _workflow
 from jointcal._workflow import campaign_index, config_problem, pending_outputs, stage_sources
@@ -156,12 +156,6 @@ def test_pending_outputs_are_the_planned_files_written_before_the_run(tmp_path):
 
 # ------------------------------------------------------------------ Snakemake runs (slow)
 
-def _snakemake(work: Path, *args: str) -> subprocess.CompletedProcess[str]:
-    env = {**os.environ, "PYTHONPATH": str(work / "src")}
-    return subprocess.run([sys.executable, "-m", "snakemake", *args], cwd=work, capture_output=True, text=True,
-                          env=env, timeout=300)
-
-
 def _jobs(res: subprocess.CompletedProcess[str]) -> dict[str, int]:
     """Rule -> job count from a dry run's "Job stats" table (empty when nothing is to be done)."""
     out = res.stdout + res.stderr
@@ -177,17 +171,11 @@ def touched(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[str]]:
     Shared by the tests below (made once: about 8 s); each leaves it as it found it, except
     the failure test, which comes last.
     """
-    work = tmp_path_factory.mktemp("touched") / "wf"
-    work.mkdir()
-    shutil.copy(REPO / "Snakefile", work)
-    ignore = shutil.ignore_patterns("__pycache__")
-    for folder in ("workflow", "profiles"):
-        shutil.copytree(REPO / folder, work / folder, ignore=ignore, symlinks=True)
-    shutil.copytree(REPO / "src" / "jointcal", work / "src" / "jointcal", ignore=ignore)
+    work = workflow_copy(tmp_path_factory.mktemp("touched"), src=True)
     cfg = ["--config", f"raw_data={SMALL_CAMPAIGN}", f"results={work / 'results'}"]
     modal = work / "results" / "modal" / "modal_properties.csv"
     for _ in range(2):  # up to the modal checkpoint, then (once it is made) the (assembly, mode) jobs its table names
-        summary = _snakemake(work, "--summary", *cfg)
+        summary = snakemake(work, "--summary", *cfg)
         assert summary.returncode == 0, summary.stderr
         for line in summary.stdout.splitlines()[1:]:
             out = Path(line.split("\t")[0])
@@ -199,7 +187,7 @@ def touched(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[str]]:
         if not modal.stat().st_size:  # the checkpoint's table, made by an ideal modal stage
             table = modal_tables({"first": TABLE_3_2["first"]}, levels=(1, 1, 2, 5, 10))[0]
             table.assign(run_id=[f"run{i:02d}" for i in range(1, 6)], mode="m2188").to_csv(modal, index=False)
-        res = _snakemake(work, "--cores", "1", "--touch", "--forceall", *cfg)
+        res = snakemake(work, "--cores", "1", "--touch", "--forceall", *cfg)
         assert res.returncode == 0, res.stderr
     return work, cfg
 
@@ -224,10 +212,10 @@ def test_editing_a_stage_module_reruns_that_stage_and_its_descendants_only(touch
     ]
     for module, expected in cases:
         original = _edit(pkg / module)
-        jobs = _jobs(_snakemake(work, "-n", *cfg))
+        jobs = _jobs(snakemake(work, "-n", *cfg))
         assert set(jobs) - {"all"} == expected, module
         (pkg / module).write_text(original)
-    assert _jobs(_snakemake(work, "-n", *cfg)) == {}  # the hash is of the content: undoing an edit undoes the rerun
+    assert _jobs(snakemake(work, "-n", *cfg)) == {}  # the hash is of the content: undoing an edit undoes the rerun
 
 
 @pytest.mark.slow
@@ -239,12 +227,12 @@ def test_discrepancy_target_runs_only_that_stage_and_what_it_needs(touched, tmp_
     module = work / "src" / "jointcal" / "discrepancy" / "select.py"
     original = _edit(module)
     try:
-        assert set(_jobs(_snakemake(work, "-n", "discrepancy", *cfg))) == {
+        assert set(_jobs(snakemake(work, "-n", "discrepancy", *cfg))) == {
             "discrepancy_assembly", "discrepancy_table", "discrepancy"}
     finally:
         module.write_text(original)
     fresh = ["--config", f"raw_data={SMALL_CAMPAIGN}", f"results={tmp_path / 'fresh'}"]
-    jobs = set(_jobs(_snakemake(work, "-n", "discrepancy", *fresh)))
+    jobs = set(_jobs(snakemake(work, "-n", "discrepancy", *fresh)))
     # (the jobs of each (assembly, mode), calibrate to discrepancy, are named once the modal checkpoint has run)
     assert {"ingest", "envelopes_runs", "modal_properties", "discrepancy_table"} <= jobs
     assert not jobs & {"modal_figures", "calibration_figures", "posterior_corner", "validate_figures",
@@ -254,13 +242,13 @@ def test_discrepancy_target_runs_only_that_stage_and_what_it_needs(touched, tmp_
 @pytest.mark.slow
 def test_typo_in_config_is_one_line_before_any_schema_dump(touched):
     work, cfg = touched
-    res = _snakemake(work, "-n", *cfg, "calibrate={populaton: 40}")
+    res = snakemake(work, "-n", *cfg, "calibrate={populaton: 40}")
     assert res.returncode != 0
     assert res.stderr.strip().splitlines()[-1] == (
         "jointcal: config key 'calibrate.populaton' is not a setting of this workflow; did you mean "
         "'calibrate.population'? (all settings: workflow/config/config.yaml)")
     assert "Failed validating" not in res.stderr and "Traceback" not in res.stderr
-    assert _jobs(_snakemake(work, "-n", *cfg, "posterior={ball: 0.002}")) == {
+    assert _jobs(snakemake(work, "-n", *cfg, "posterior={ball: 0.002}")) == {
         "posterior_assembly": 1, "posterior_corner": 1, "posterior_report": 1, "report_summary": 1,
         "validate_assembly": 1, "validate_figures": 1, "discrepancy_assembly": 1, "discrepancy_table": 1,
         "design_assembly": 1, "all": 1}  # params changed: the posterior and what uses its chain
@@ -276,7 +264,7 @@ def test_slurm_profile_dry_run_has_one_job_per_assembly_and_mode(tmp_path, touch
     shutil.copytree(REPO / "workflow", work / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
     shutil.copytree(REPO / "src" / "jointcal", work / "src" / "jointcal", ignore=shutil.ignore_patterns("__pycache__"))
     slurm = ["--workflow-profile", "workflow/profiles/slurm"]
-    res = _snakemake(work, "-n", *slurm, "--config", f"raw_data={REPO / 'raw_data'}", f"results={tmp_path / 'results'}")
+    res = snakemake(work, "-n", *slurm, "--config", f"raw_data={REPO / 'raw_data'}", f"results={tmp_path / 'results'}")
     assert "workflow/profiles/slurm" in res.stderr + res.stdout
     assert "checkpoint" in res.stderr + res.stdout  # the jobs after modal are named by its table
     assert _jobs(res) == {"compile_kernels": 1, "ingest": 1, "envelopes_runs": 1, "modal_properties": 1, "modal_figures": 1,
@@ -288,7 +276,7 @@ def test_slurm_profile_dry_run_has_one_job_per_assembly_and_mode(tmp_path, touch
     assert resources["envelopes_runs"]["cpus_per_task"] == "2"
     twork, cfg = touched
     per_unit = ["calibrate_assembly", "posterior_assembly", "validate_assembly", "discrepancy_assembly", "design_assembly"]
-    res = _snakemake(twork, "-n", *slurm, *cfg, "--forcerun", *per_unit)
+    res = snakemake(twork, "-n", *slurm, *cfg, "--forcerun", *per_unit)
     jobs = _jobs(res)
     assert all(jobs[r] == 1 for r in per_unit), jobs  # the small campaign: one assembly, one mode
     assert re.search(r"wildcards: assembly=first, mode=m2188", res.stdout + res.stderr)
@@ -310,7 +298,7 @@ def test_failed_rerun_removes_the_downstream_outputs_it_could_not_remake(touched
     assert all(p.is_file() for p in upstream + downstream)
     modal = work / "src" / "jointcal" / "measure" / "modal.py"
     modal.write_text(modal.read_text() + "\nraise RuntimeError('a bug in the new modal code')\n")
-    res = _snakemake(work, "--cores", "1", *cfg)
+    res = snakemake(work, "--cores", "1", *cfg)
     assert res.returncode != 0
     assert "a bug in the new modal code" in res.stderr
     assert "so nothing out of date looks current" in res.stderr

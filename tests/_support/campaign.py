@@ -58,16 +58,6 @@ def edit_run(campaign: Path, file: str, edit: Callable[[pd.DataFrame], pd.DataFr
     df.to_csv(campaign / file, index=False, float_format="%.9g")
 
 
-def workflow_copy(tmp_path: Path) -> Path:
-    """A copy of Snakefile, workflow/ and profiles/ in tmp_path/wf: the working directory of a workflow run."""
-    work = tmp_path / "wf"
-    work.mkdir()
-    shutil.copy(REPO / "Snakefile", work)
-    for folder in ("workflow", "profiles"):
-        shutil.copytree(REPO / folder, work / folder, ignore=shutil.ignore_patterns("__pycache__"))
-    return work
-
-
 def unit(results: Path, assembly: str) -> str:
     """The mode of an assembly that holds one (its folder under each per-unit stage: ``<stage>/<assembly>/<mode>``)."""
     from jointcal._workflow import modal_units

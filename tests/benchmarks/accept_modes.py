@@ -25,7 +25,7 @@ import pandas as pd
 HERE = Path(__file__).parents[2]
 sys.path.insert(0, str(HERE))
 from tests._support import two_modes as _two_modes  # noqa: E402
-from tests._support.campaign import workflow_copy  # noqa: E402
+from tests._support.workflow import workflow_copy  # noqa: E402
 
 TRUTH_OF = {"m99": "low", "m227": "high", "m226": "high"}
 
