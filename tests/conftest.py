@@ -7,10 +7,11 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
-from tests._support.campaign import DEFAULT_SPEC, SMALL_CAMPAIGN, voltage_campaign
-from tests._support.modal_helpers import modal_table
 
 from jointcal.synth import generate
+from tests._support.campaign import DEFAULT_SPEC, SMALL_CAMPAIGN, example_copy, voltage_campaign
+from tests._support.ingest import OTHER, RUN
+from tests._support.modal_helpers import modal_table
 
 
 @pytest.fixture(scope="session")
@@ -52,3 +53,9 @@ def default_modal(default_campaign_dir: Path) -> pd.DataFrame:
     """The modal stage's table of `default_campaign_dir` (every run through `jointcal.modal.measure_run`);
     a copy per use is the caller's to make before editing it."""
     return modal_table(default_campaign_dir)
+
+
+@pytest.fixture
+def example(tmp_path: Path) -> Path:
+    """Two clean runs of the example campaign, to break the first."""
+    return example_copy(tmp_path / "campaign", RUN, OTHER)

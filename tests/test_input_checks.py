@@ -12,16 +12,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from tests._support.campaign import REPO, edit_manifest, edit_run
-from tests._support.workflow import snakemake, workflow_copy
 from scipy import signal
 
 from jointcal.calibrate.data import select_modal
 from jointcal.cli import main
 from jointcal.io import CampaignError, CampaignWarning, ingest_campaign, listed_record, read_run, validate_run
 from jointcal.io._clipping import clip_levels, clipped_mask
-from jointcal.units import G_SI  # m/s^2 per g
-
+from tests._support.campaign import REPO, edit_manifest, edit_run
+from tests._support.ingest import _set, _si
 
 
 def _one_sentence(msg: str, *words: str) -> None:
@@ -148,13 +146,6 @@ def test_silent_dropout_is_not_clipping(small_campaign):
     assert clip_levels(df["response_accel_g"].to_numpy()) == []
 
 
-# ------------------------------------------------------------------------ base amplitude vs level_g
-
-
-def _si(d: pd.DataFrame) -> None:
-    d[["base_accel_g", "response_accel_g"]] *= G_SI
-
-
 def test_record_in_si_units_is_named_and_flagged(campaign):
     edit_run(campaign, "run03.csv.gz", _si)
     flags = _flag(campaign, "run03", "run03.csv.gz", "base amplitude is 19.6 g where the manifest says level_g = 2 g",
@@ -189,15 +180,6 @@ def test_level_mistakes_are_left_out_of_the_calibration():
                                     "clipped:response_accel_g"]})
     data = select_modal(modal, "first")
     assert data.run_id == ("r1",)  # clipped: the peak is missing, damping biased high (see below)
-
-
-# ------------------------------------------------------------------------ dead and swapped channels
-
-
-def _set(col, value):
-    def edit(d):
-        d[col] = value
-    return edit
 
 
 @pytest.mark.parametrize("col", ["response_accel_g", "base_accel_g"])
@@ -317,48 +299,6 @@ def test_malformed_synth_spec_is_one_sentence(tmp_path, capsys, text, words):
     err = capsys.readouterr().err.strip()
     _one_sentence(err, str(spec), *words)
     assert not out.exists() and not (tmp_path / "truth.json").exists()
-
-
-# ------------------------------------------------------------------------ workflow
-
-
-@pytest.mark.slow
-def test_workflow_keeps_the_nan_warning_when_an_error_follows(tmp_path, campaign):
-    edit_run(campaign, "run01.csv.gz", _set("base_accel_g", np.nan))
-    edit_manifest(campaign, lambda m: m.assign(sample_rate_hz=m["sample_rate_hz"].where(m["run_id"] != "run04",
-                                                                                          "12700")))
-    out = tmp_path / "results"
-    res = snakemake(workflow_copy(tmp_path), "--cores", "2", "ingest", "--config", f"raw_data={campaign}", f"results={out}")
-    assert res.returncode != 0
-    log = (out / "logs" / "ingest.log").read_text().splitlines()
-    assert len(log) == 2 and "run01.csv.gz: column 'base_accel_g' has 9600 NaN/inf values" in log[0]
-    assert "run04.csv.gz: the measured sample rate" in log[1] and "sweep" not in log[0]
-    assert "run01.csv.gz" in res.stderr and "run04.csv.gz" in res.stderr
-    assert not (out / "ingest" / "runs.csv").exists()
-
-
-@pytest.mark.slow
-def test_workflow_keeps_a_units_mistake_out_of_the_modal_fit(tmp_path, campaign):
-    """Flagged before calibration: a record in m/s^2 reaches modal_properties.csv as unusable
-    (select_modal leaves it out; a wrong level takes the same path, see the tests above). Its file
-    and a clean run's file share a basename in two folders (2 runs: CI time)."""
-    edit_run(campaign, "run03.csv.gz", _si)
-    edit_manifest(campaign, lambda m: m[m["run_id"].isin(["run01", "run03"])])
-    for rid, folder in (("run01", "a"), ("run03", "b")):
-        (campaign / folder).mkdir()
-        shutil.move(campaign / f"{rid}.csv.gz", campaign / folder / "run.csv.gz")
-        edit_manifest(campaign, lambda m, r=rid, f=folder: m.assign(
-            file=m["file"].where(m["run_id"] != r, f"{f}/run.csv.gz")))
-    out = tmp_path / "results"
-    res = snakemake(workflow_copy(tmp_path), "--cores", "2", str(out / "modal" / "modal_properties.csv"),
-                     "--config", f"raw_data={campaign}", f"results={out}")
-    assert res.returncode == 0, res.stderr
-    assert "b/run.csv.gz: base amplitude is 19.6 g" in (out / "logs" / "ingest.log").read_text()
-    assert "run03: unusable: ingest flagged level:base_accel_g" in (out / "logs" / "modal.log").read_text()
-    modal = pd.read_csv(out / "modal" / "modal_properties.csv", keep_default_na=False).set_index("run_id")
-    assert modal.loc["run03", "flags"].split(";")[:1] == ["level:base_accel_g"]
-    assert "unusable" in modal.loc["run03", "flags"] and "unusable" not in modal.loc["run01", "flags"]
-    assert select_modal(modal.reset_index(), "first").run_id == ("run01",)
 
 
 def test_clipped_runs_stay_out_of_the_fit_because_leaving_frames_out_does_not_save_the_damping():

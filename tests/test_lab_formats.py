@@ -11,12 +11,12 @@ import pandas as pd
 import pytest
 import pyuff
 import scipy.io
-from tests._support.campaign import edit_manifest, example_copy
 from nptdms import ChannelObject, GroupObject, TdmsWriter
 
 from jointcal.io import CampaignError, ingest_campaign, read_manifest, read_run
 from jointcal.measure.modal import measure_run
 from jointcal.units import G_SI  # m/s^2 per g
+from tests._support.campaign import edit_manifest, example_copy
 
 EXAMPLE_RUN = "first_01_1g_up"
 NAMES = {"base_accel_g": "Ctrl Z", "drive_V": "Amp out", "response_accel_g": "Slug Z"}
@@ -256,34 +256,6 @@ def test_a_file_that_is_not_its_format_is_one_sentence(tmp_path, example_src):
     (folder / f"runs/{EXAMPLE_RUN}.tdms").write_bytes(gzip.compress(b"time_s,base_accel_g\n"))
     with pytest.raises(CampaignError, match="cannot be read as a TDMS file"):
         ingest_campaign(folder)
-
-
-@pytest.mark.slow
-def test_workflow_reads_lab_exports_as_it_reads_the_csv(tmp_path, voltage_source):
-    """The voltage campaign with one run as TDMS and the other as a Test.Lab struct: the workflow's modal
-    table is the CSV campaign's (every stage reads the record with its manifest row)."""
-    import shutil
-
-    from tests._support.workflow import snakemake, workflow_copy
-
-    lab = Path(shutil.copytree(voltage_source, tmp_path / "lab"))
-    man = read_manifest(lab / "manifest.csv")
-    for row, suffix in zip(man.to_dict("records"), (".tdms", ".mat")):
-        df = read_run(lab / row["file"], row)
-        WRITERS[suffix](lab / row["file"].replace(".csv.gz", suffix), df, {"drive_V": "V", "response_accel_g": "g"})
-        (lab / row["file"]).unlink()
-    edit_manifest(lab, lambda m: m.assign(file=[f.replace(".csv.gz", s) for f, s in zip(m["file"], (".tdms", ".mat"))],
-                                          reference_channel=NAMES["drive_V"], response_channel=NAMES["response_accel_g"]))
-    tables = {}
-    for name, campaign in (("csv", voltage_source), ("lab", lab)):
-        out = tmp_path / f"results_{name}"
-        (tmp_path / f"wf_{name}").mkdir()
-        res = snakemake(workflow_copy(tmp_path / f"wf_{name}"), "--cores", "2", "modal_properties", "--config",
-                        f"raw_data={campaign}", f"results={out}")
-        assert res.returncode == 0, res.stderr[-3000:]
-        tables[name] = pd.read_csv(out / "modal" / "modal_properties.csv", keep_default_na=False)
-    assert (tables["lab"]["f_res_method"] == "sweep_fit").all()
-    pd.testing.assert_frame_equal(tables["lab"], tables["csv"])
 
 
 def test_a_lab_export_read_without_its_manifest_row_says_so(tmp_path, example_src):

@@ -17,23 +17,14 @@ import numpy as np
 import pandas as pd
 import pytest
 import scipy.io
-from tests._support.campaign import REPO, edit_manifest, edit_run, example_copy
-from tests._support.workflow import snakemake, workflow_copy
 
 from jointcal.cli import main
 from jointcal.io import CampaignError, CampaignWarning, ingest_campaign, read_manifest, read_run, validate_run
 from jointcal.io._amplitudes import low_frequency_ratio
 from jointcal.io._time import check_time, time_resolution
 from jointcal.units import G_SI  # m/s^2 per g
-
-RUN, OTHER = "first_01_1g_up", "first_07_2g_up"  # a 1 g up sweep and a 2 g one, from raw_data/
-FILE = f"runs/{RUN}.csv.gz"
-
-
-@pytest.fixture
-def example(tmp_path: Path) -> Path:
-    """Two clean runs of the example campaign, to break the first."""
-    return example_copy(tmp_path / "campaign", RUN, OTHER)
+from tests._support.campaign import REPO, edit_manifest, edit_run
+from tests._support.ingest import FILE, OTHER, RUN, _scale
 
 
 def _one_sentence(msg: str, *words: str) -> None:
@@ -71,12 +62,6 @@ def _stopped(campaign: Path, capsys, *words: str) -> str:
     assert len(lines) == 1 and lines[0].startswith("jointcal: ") and "Traceback" not in err, err
     _one_sentence(lines[0], *words)
     return lines[0]
-
-
-def _scale(col: str, factor: float):
-    def edit(d: pd.DataFrame) -> None:
-        d[col] = d[col] * factor
-    return edit
 
 
 # ------------------------------------------------------------------------ the response's units, base-driven
@@ -452,43 +437,3 @@ def test_a_silent_pre_trigger_head_is_named_and_sweep_start_s_reads_the_run(exam
     assert runs.loc[RUN, "sweep_start_s"] == 0.25 and runs.loc[OTHER, "sweep_start_s"] == 0.0
     row = read_manifest(example / "manifest.csv").iloc[0]
     assert len(read_run(example / FILE, row)) == len(read_run(REPO / "raw_data" / FILE))
-
-
-# ------------------------------------------------------------------------ the workflow
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize("case", ["windows path", "missing file"])
-def test_workflow_names_a_windows_path_or_a_missing_file_before_looking_for_inputs(tmp_path, example, case):
-    if case == "windows path":
-        edit_manifest(example, lambda m: m.assign(file=m["file"].str.replace("/", "\\")))
-        words = f"file 'runs\\{RUN}.csv.gz' is written with a Windows backslash"
-    else:
-        (example / FILE).unlink()
-        words = f"{FILE}: the file of run '{RUN}' listed in manifest.csv (line 2) does not exist"
-    out = tmp_path / "results"
-    res = snakemake(workflow_copy(tmp_path), "--cores", "2", "ingest", "--config", f"raw_data={example}", f"results={out}")
-    assert res.returncode != 0
-    assert "MissingInputException" not in res.stderr and "Traceback" not in res.stderr, res.stderr
-    assert f"jointcal: {example / 'manifest.csv'}" in res.stderr or f"jointcal: {example / FILE}" in res.stderr
-    assert words in res.stderr
-    log = (out / "logs" / "ingest.log").read_text().splitlines()
-    assert len(log) == 1 and words in log[0]
-    assert not (out / "ingest").exists()
-
-
-@pytest.mark.slow
-def test_workflow_keeps_a_response_units_mistake_out_of_the_calibration(tmp_path, example):
-    """The flagged run reaches modal_properties.csv as unusable; the calibration's selection leaves it out."""
-    from jointcal.calibrate.data import select_modal
-
-    edit_run(example, FILE, _scale("response_accel_g", G_SI))
-    out = tmp_path / "results"
-    res = snakemake(workflow_copy(tmp_path), "--cores", "2", str(out / "modal" / "modal_properties.csv"),
-                     "--config", f"raw_data={example}", f"results={out}")
-    assert res.returncode == 0, res.stderr[-3000:]
-    assert f"{FILE}: below resonance" in (out / "logs" / "ingest.log").read_text()
-    modal = pd.read_csv(out / "modal" / "modal_properties.csv", keep_default_na=False).set_index("run_id")
-    assert modal.loc[RUN, "flags"].split(";")[0] == "units:response_accel_g"
-    assert "unusable" in modal.loc[RUN, "flags"].split(";") and "unusable" not in modal.loc[OTHER, "flags"]
-    assert select_modal(modal.reset_index(), "first").run_id == (OTHER,)

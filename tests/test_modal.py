@@ -5,7 +5,6 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from tests._support.modal_helpers import against_truth, modal_table
 from jointcal.io import write_run
 from jointcal.measure.envelopes import envelopes
 from jointcal.measure.modal import modal_properties
@@ -13,6 +12,7 @@ from jointcal.measure.scatter import scatter
 from jointcal.models import G, IwanParams, MinistackModel, harmonic_balance, simulate
 from jointcal.synth import generate
 from jointcal.synth.daq import controlled_sweep
+from tests._support.modal_helpers import against_truth, modal_table
 
 pytestmark = pytest.mark.slow
 
@@ -112,52 +112,6 @@ def test_channel_delay_shifts_quadrature_as_2_pi_f_tau_predicts(tmp_path):
         f_pred = fa[near][k] - gap[k] * (fa[near][k + 1] - fa[near][k]) / (gap[k + 1] - gap[k])
         print(f"\n{row['run_id']}: shift {b.loc[i, 'f_res_hz'] - f_a:+.2f} Hz, predicted {f_pred - f_a:+.2f} Hz")
         assert b.loc[i, "f_res_hz"] - f_a == pytest.approx(f_pred - f_a, rel=0.05)
-
-
-def _merge_run(dst: Path, src: Path, run_id: str, new_id: str, sequence: int) -> None:
-    """Copy one run of campaign src into campaign dst under a new id."""
-    ms, md = pd.read_csv(src / "manifest.csv"), pd.read_csv(dst / "manifest.csv")
-    row = ms[ms.run_id == run_id].iloc[0].copy()
-    target = dst / "runs" / f"{new_id}.csv.gz"
-    target.write_bytes((src / row["file"]).read_bytes())
-    row["run_id"], row["file"], row["sequence"] = new_id, f"runs/{new_id}.csv.gz", sequence
-    pd.concat([md, row.to_frame().T]).to_csv(dst / "manifest.csv", index=False)
-
-
-def test_bad_runs_inside_a_valid_campaign_are_flagged_and_the_rest_finish(tmp_path):
-    """Workflow: a band that misses the resonance, a clipped response, a NaN burst."""
-    from tests._support.workflow import snakemake, workflow_copy
-
-    base = {"seed": 9, "sweep": {"f_start_hz": 1500.0, "f_stop_hz": 2700.0, "rate_hz_per_s": 400.0},
-            "series": [{"level_g": 1.0, "directions": ["up", "down"]}], "assemblies": {"first": FIRST}}
-    generate(base, tmp_path / "c", tmp_path / "t.json")
-    generate({**base, "sweep": {"f_start_hz": 700.0, "f_stop_hz": 1500.0, "rate_hz_per_s": 400.0}},
-             tmp_path / "low", tmp_path / "t2.json")
-    generate({**base, "measurement": {"full_scale_g": {"base": "auto", "response": 10.0}}},
-             tmp_path / "clip", tmp_path / "t3.json")
-    _merge_run(tmp_path / "c", tmp_path / "low", "first_01_1g_up", "low_band", 3)
-    _merge_run(tmp_path / "c", tmp_path / "clip", "first_01_1g_up", "clipped", 4)
-    from jointcal.io import read_run
-    nanfile = tmp_path / "c" / "runs" / "first_02_1g_down.csv.gz"
-    df = read_run(nanfile)
-    df.loc[30000:30200, "response_accel_g"] = np.nan
-    write_run(nanfile, df["time_s"], df["base_accel_g"], df["response_accel_g"])
-    work = workflow_copy(tmp_path)
-    out = tmp_path / "results"
-    res = snakemake(work, "--cores", "2", "modal", "--config", f"raw_data={tmp_path / 'c'}", f"results={out}")
-    assert res.returncode == 0, res.stderr[-3000:]
-    t = pd.read_csv(out / "modal" / "modal_properties.csv", dtype={"flags": str}).set_index("run_id")
-    t["flags"] = t["flags"].fillna("")
-    assert "unusable" in t.loc["low_band", "flags"] and "resonance_outside_band" in t.loc["low_band", "flags"]
-    assert "clipped:response_accel_g" in t.loc["clipped", "flags"]
-    assert "nonfinite:response_accel_g" in t.loc["first_02_1g_down", "flags"]
-    assert "bad_samples" in t.loc["first_02_1g_down", "flags"]
-    assert t.loc["first_01_1g_up", "flags"] == ""
-    assert abs(t.loc["first_02_1g_down", "f_res_hz"] / t.loc["first_01_1g_up", "f_res_hz"] - 1) < 5e-4
-    log = (out / "logs" / "modal.log").read_text()
-    for rid in ("low_band", "clipped", "first_02_1g_down"):
-        assert f"warning: {rid}:" in log and f"warning: {rid}:" in res.stderr
-    assert (out / "figures" / "fig3_6_frequency_damping.png").is_file()
 
 
 def _force_campaign(folder: Path, response="driving_point"):

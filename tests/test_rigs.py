@@ -210,35 +210,3 @@ def test_rig_model_keeps_the_joint():
     sh = Shaker()
     lo, hi = rig_pole(model, sh, 1e-7), rig_pole(model, sh, 2e-4)
     assert hi[0] < 0.95 * lo[0] and hi[1] > lo[1]
-
-
-@pytest.mark.slow
-def test_workflow_reads_a_voltage_driven_chirp_campaign(tmp_path):
-    """Workflow 'modal_properties' on a voltage-driven beam campaign (eta-20 chirps, up and down):
-    ingest takes level_V / drive_V, the modal stage reads the rig's pole (swept-mode fit; pair backbone
-    and FRF fit beside it), each
-    run's FRF is written."""
-    import pandas as pd
-    from tests._support.workflow import snakemake, workflow_copy
-
-    spec = {"seed": 8, "sample_rate_hz": 1024.0, "sweep": {"f_start_hz": 70.0, "f_stop_hz": 130.0,
-                                                           "rate_hz_per_s": 20.0 * (97.66 * 0.0192) ** 2,
-                                                           "tail_s": 1.0},
-            "series": [{"level_V": 1.0, "directions": ["up", "down"]}], "assemblies": {"beam": BEAM},
-            "rig": {"reference": "voltage", "shaker": SHAKER}}
-    generate(spec, tmp_path / "c", tmp_path / "t.json")
-    truth = json.loads((tmp_path / "t.json").read_text())["runs"]
-    work = workflow_copy(tmp_path)
-    out = tmp_path / "results"
-    res = snakemake(work, "--cores", "2", "modal_properties", "--config", f"raw_data={tmp_path / 'c'}",
-                    f"results={out}")
-    assert res.returncode == 0, res.stderr[-3000:]
-    t = pd.read_csv(out / "modal" / "modal_properties.csv", dtype={"flags": str})
-    assert (t["f_res_method"] == "sweep_fit").all() and "level_V" in t.columns
-    for r, tr in zip(t.to_dict("records"), truth):
-        assert r["f_res_hz"] == pytest.approx(tr["f_rig_hz"], rel=2e-3)
-        assert r["zeta_frf"] == pytest.approx(tr["zeta_rig"], rel=0.05)
-        assert r["zeta_backbone"] == pytest.approx(tr["zeta_rig"], rel=0.05)
-        assert r["zeta_sweep"] == pytest.approx(tr["zeta_rig"], rel=0.05)
-        frf = pd.read_csv(out / "modal" / "frf" / f"{r['run_id']}.csv")
-        assert {"h1_re", "h2_re", "coherence", "fit_re"} <= set(frf.columns)

@@ -38,3 +38,10 @@ def snakemake(work: Path, *args: str) -> subprocess.CompletedProcess[str]:
     env = {**os.environ, "PYTHONPATH": str(src)}
     return subprocess.run([sys.executable, "-m", "snakemake", *args], cwd=work, capture_output=True, text=True,
                           env=env, timeout=TIMEOUT_S)
+
+
+def _edit(path: Path) -> str:
+    """Append a comment to a module (a change to its text, not to what it does); return the original."""
+    text = path.read_text()
+    path.write_text(text + "\n# edited by test_workflow_mechanics\n")
+    return text

@@ -4,68 +4,29 @@ progress in the logs, no stale outputs after a failure, and the slurm profile.
 The Snakemake tests run on a copy of the repository's Snakefile, workflow/ and src/jointcal
 (so a module can be edited) with the small committed campaign, and mark the workflow's
 outputs as made with ``--touch`` instead of computing them: what is checked is which jobs
-Snakemake schedules, not what they compute (test_workflow.py runs them for real).
+Snakemake schedules, not what they compute (test_snakefile.py runs them for real).
 """
 from __future__ import annotations
 
-import os
 import re
 import shutil
 import subprocess
 from pathlib import Path
 
-import pandas as pd
 import pytest
-from tests._support.campaign import REPO, SMALL_CAMPAIGN, edit_manifest
-from tests._support.modal_tables import TABLE_3_2, modal_tables, write_tables
-from tests._support.workflow import snakemake, workflow_copy
 
-from jointcal import _workflow
-from jointcal._workflow import campaign_index, config_problem, pending_outputs, stage_sources
 from jointcal.calibrate import CalibrateSettings, run_calibration
 from jointcal.posterior import PosteriorSettings, run_posterior
+from tests._support.campaign import REPO, SMALL_CAMPAIGN
+from tests._support.modal_tables import TABLE_3_2, modal_tables, write_tables
+from tests._support.workflow import _edit, snakemake, workflow_copy
 
-SCRIPTS = REPO / "workflow" / "scripts"
-SCHEMA = REPO / "workflow" / "schemas" / "config.schema.yaml"
 PER_UNIT = {"modal_unit", "calibrate_assembly", "calibration_figures", "posterior_assembly", "posterior_corner",
             "validate_assembly", "discrepancy_assembly", "design_assembly"}
 DOWNSTREAM_OF_MODAL = {"modal_properties", "modal_figures", "modal_unit", "calibrate_assembly", "calibration_figures",
                        "posterior_assembly", "posterior_corner", "posterior_report", "report_summary",
                        "validate_assembly", "validate_figures", "discrepancy_assembly", "discrepancy_table",
                        "design_assembly"}
-
-
-def _names(files: list[Path]) -> set[str]:
-    return {f.relative_to(REPO / "src" / "jointcal").as_posix() for f in files[1:]}
-
-
-def test_stage_sources_follow_imports_through_the_package():
-    assert stage_sources(SCRIPTS / "modal.py")[0] == SCRIPTS / "modal.py"  # the script's own text counts too
-    modal = _names(stage_sources(SCRIPTS / "modal.py"))
-    assert {"measure/modal.py", "measure/envelopes.py", "io/__init__.py", "io/_checks.py", "__init__.py"} <= modal
-    assert not any(n.startswith(("calibrate/", "posterior/", "report/")) for n in modal)
-    assert "measure/modal.py" not in _names(stage_sources(SCRIPTS / "ingest.py"))
-    assert "measure/modal.py" not in _names(stage_sources(SCRIPTS / "envelopes.py"))
-    # `from ..calibrate.space import ...` in report/calibration.py, and the packages' __init__ files
-    figures = _names(stage_sources(SCRIPTS / "calibration_figures.py"))
-    assert {"report/__init__.py", "report/calibration.py", "calibrate/__init__.py", "calibrate/space.py"} <= figures
-
-
-def test_an_edit_of_measure_peaks_changes_no_stage_hash_before_modal(tmp_path, monkeypatch):
-    """The hash the rules pass as params (common.smk's source_hash: `stage_hash` of the script), on a copy of the
-    package whose measure/peaks.py is edited: ingest, envelopes and the kernels keep theirs, modal's changes."""
-    before_modal = [re.search(r'script:\s*"\.\./scripts/(\w+\.py)"', block).group(1)
-                    for smk in ("ingest", "envelopes", "kernels")
-                    for block in re.split(r"(?m)^(?=rule )", (REPO / "workflow" / "rules" / f"{smk}.smk").read_text())
-                    if "script:" in block]
-    assert {"ingest.py", "envelopes.py", "kernels.py"} <= set(before_modal)
-    pkg = tmp_path / "jointcal"
-    shutil.copytree(REPO / "src" / "jointcal", pkg, ignore=shutil.ignore_patterns("__pycache__"))
-    monkeypatch.setattr(_workflow, "_ROOT", pkg.resolve())
-    hashes = {s: _workflow.stage_hash(SCRIPTS / s) for s in [*before_modal, "modal.py"]}
-    _edit(pkg / "measure" / "peaks.py")
-    assert {s: _workflow.stage_hash(SCRIPTS / s) for s in before_modal} == {s: hashes[s] for s in before_modal}
-    assert _workflow.stage_hash(SCRIPTS / "modal.py") != hashes["modal.py"]  # the hash does see the edit
 
 
 def test_every_script_rule_carries_its_code_hash_a_benchmark_and_slurm_threads():
@@ -86,25 +47,6 @@ def test_every_script_rule_carries_its_code_hash_a_benchmark_and_slurm_threads()
         assert name in profile["set-threads"], name
 
 
-def test_typo_in_a_nested_key_names_the_nearest_valid_key():
-    config = {"raw_data": "raw_data", "calibrate": {"bounds": {"Fs": [1, 10]}, "populaton": 40}}
-    msg = config_problem(config, SCHEMA)
-    assert msg is not None and "\n" not in msg
-    assert "'calibrate.populaton'" in msg and "did you mean 'calibrate.population'?" in msg
-    assert "did you mean 'resul" in config_problem({"resuls": "out"}, SCHEMA)
-
-
-def test_nested_config_given_as_text_is_converted_or_named_in_one_line():
-    config = {"posterior": {"ball": "0.005", "rel_std_floor": {"frequency": "1e-3"}},  # as --config leaves them
-              "calibrate": {"bounds": {"Fs": ["1", "100"]}, "model": "qsma"}}
-    assert config_problem(config, SCHEMA) is None
-    assert config["posterior"]["ball"] == 0.005 and config["posterior"]["rel_std_floor"]["frequency"] == 1e-3
-    assert config["calibrate"]["bounds"]["Fs"] == [1, 100] and config["calibrate"]["model"] == "qsma"
-    msg = config_problem({"posterior": {"ball": "small"}}, SCHEMA)
-    assert msg.startswith("config 'posterior.ball': 'small' is not of type 'number'")
-    assert "--configfile my.yaml" in msg and "\n" not in msg
-
-
 def test_ga_generation_and_chain_tau_reach_the_log_while_running(tmp_path):
     modal_csv, scatter_csv = write_tables(tmp_path, {"a": TABLE_3_2["first"]}, seed=3)
     lines: list[str] = []
@@ -120,38 +62,6 @@ def test_ga_generation_and_chain_tau_reach_the_log_while_running(tmp_path):
     assert [ln.split(":")[0] for ln in lines] == ["posterior step 100/200", "posterior step 200/200"]
     assert re.search(r"largest autocorrelation time \d+ steps, chain [\d.]+ tau \(stops at 50 tau\); checkpoint ",
                      lines[-1]), lines[-1]
-
-
-def test_campaign_index_reads_the_manifest_and_keeps_its_problem(campaign):
-    manifest = pd.read_csv(SMALL_CAMPAIGN / "manifest.csv", dtype=str)
-    index = campaign_index(SMALL_CAMPAIGN / "manifest.csv")
-    assert list(index.run_files) == list(manifest["run_id"]) and index.problem is None
-    assert index.run_files[manifest["run_id"][0]] == str(SMALL_CAMPAIGN / manifest["file"][0])
-    assert index.assemblies == list(dict.fromkeys(manifest["assembly"])) and index.excitation == "base"
-    first = manifest["assembly"][0]
-    assert index.assembly_files(first) == [str(SMALL_CAMPAIGN / f) for f in manifest.loc[manifest["assembly"] == first,
-                                                                                         "file"]]
-    # a listed record that is missing: the names still come through, with read_manifest's sentence kept
-    edit_manifest(campaign, lambda d: d.assign(file=d["file"].where(d.index > 0, "gone.csv")))
-    broken = campaign_index(campaign / "manifest.csv")
-    assert list(broken.run_files) == list(manifest["run_id"]) and broken.excitation == "base"
-    assert "gone.csv: the file of run" in broken.problem
-    edit_manifest(campaign, lambda d: d.rename(columns={"level_g": "level_V"}))  # the records are not read
-    assert campaign_index(campaign / "manifest.csv").excitation == "voltage"
-
-
-def test_pending_outputs_are_the_planned_files_written_before_the_run(tmp_path):
-    old, new, done = tmp_path / "old.csv", tmp_path / "new.csv", tmp_path / "done.csv"
-    for f in (old, done, new):
-        f.write_text("x\n")
-    os.utime(old, (1000.0, 1000.0))
-    os.utime(done, (1000.0, 1000.0))
-    summary = ("output_file\tdate\trule\tlog-file(s)\tstatus\tplan\n"
-               f"{old}\t-\tr\t-\tok\tupdate pending\n{done}\t-\tr\t-\tok\tno update\n"
-               f"{new}\t-\tr\t-\tok\tupdate pending\n{tmp_path / 'missing.csv'}\t-\tr\t-\tmissing\tupdate pending\n"
-               f"{tmp_path}\t-\tr\t-\tok\tupdate pending\n")
-    assert pending_outputs(summary, before=2000.0) == [old]  # not new (written since), done, missing, a folder
-    assert pending_outputs("Building DAG of jobs...", before=2000.0) == []
 
 
 # ------------------------------------------------------------------ Snakemake runs (slow)
@@ -190,13 +100,6 @@ def touched(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[str]]:
         res = snakemake(work, "--cores", "1", "--touch", "--forceall", *cfg)
         assert res.returncode == 0, res.stderr
     return work, cfg
-
-
-def _edit(path: Path) -> str:
-    """Append a comment to a module (a change to its text, not to what it does); return the original."""
-    text = path.read_text()
-    path.write_text(text + "\n# edited by test_workflow_mechanics\n")
-    return text
 
 
 @pytest.mark.slow
@@ -306,39 +209,3 @@ def test_failed_rerun_removes_the_downstream_outputs_it_could_not_remake(touched
     assert not (results / "modal" / "modal_properties.csv").exists()  # the failed job's own (Snakemake's doing)
     assert all(p.is_file() for p in upstream)  # up to date: kept
     assert (results / "logs" / "modal.log").is_file()
-
-
-def _settings(node, path=()):
-    """Every leaf setting of a config (path, value), a list being one setting."""
-    if isinstance(node, dict) and node:
-        for k, v in node.items():
-            yield from _settings(v, (*path, k))
-    else:
-        yield path, node
-
-
-def test_every_setting_given_on_the_command_line_as_the_readme_shows_is_read_as_its_value():
-    """Each setting of config.yaml given as ``--config 'section={key: value}'`` (Snakemake's own parser,
-    which leaves nested values as text) is read back as the value the config file gives, or stops in one
-    sentence; a list-or-null setting (modal.mode_hz) takes a number, a list and null."""
-    import yaml
-    from snakemake.cli import parse_config
-    from snakemake.utils import update_config
-
-    defaults = yaml.safe_load((REPO / "workflow" / "config" / "config.yaml").read_text())
-    cases = [(p, v) for p, v in _settings(defaults)]
-    cases += [(("modal", "mode_hz"), 95.0), (("modal", "mode_hz"), [18.6, 95.0]), (("modal", "mode_hz"), None)]
-    assert len(cases) > 40  # the walk reached the nested sections
-    for path, value in cases:
-        text = yaml.safe_dump(value, default_flow_style=True).strip().removesuffix("...").strip()
-        for key in reversed(path[1:]):
-            text = f"{{{key}: {text}}}"
-        config = yaml.safe_load((REPO / "workflow" / "config" / "config.yaml").read_text())
-        update_config(config, parse_config([f"{path[0]}={text}"]))
-        assert config_problem(config, SCHEMA) is None, (path, text)
-        got = config
-        for key in path:
-            got = got[key]
-        assert got == value, (path, text, got)
-    msg = config_problem({"modal": {"mode_hz": ["95", "high"]}}, SCHEMA)
-    assert msg is not None and "\n" not in msg and "modal.mode_hz" in msg

@@ -7,14 +7,13 @@ without the upstream stages.
 from __future__ import annotations
 
 import json
-import shutil
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 import yaml
-from tests._support.campaign import REPO, unit
+from tests._support.campaign import unit
 from tests._support.modal_tables import M, TABLE_3_2, write_tables
 from tests._support.workflow import snakemake
 
@@ -45,10 +44,10 @@ SMALL = ["--configfile", "small.yaml"]  # a small GA and a short chain, merged o
 
 
 @pytest.fixture
-def workdir(tmp_path: Path) -> Path:
-    work = tmp_path / "wf"
-    work.mkdir()
-    shutil.copytree(REPO / "workflow", work / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
+def workdir(workdir: Path) -> Path:
+    """The workflow copy (tests/workflow/conftest.py) with SNAKEFILE for its Snakefile, small settings, a manifest
+    naming the two assemblies and the modal stage's tables of Table 3.2's joints."""
+    work = workdir
     (work / "Snakefile").write_text(SNAKEFILE)
     (work / "small.yaml").write_text(yaml.safe_dump({
         "calibrate": {"population": 40, "offspring": 40, "generations": 8, "n_polish": 2},
@@ -139,7 +138,8 @@ def test_bad_input_is_one_sentence_naming_the_file(workdir):
     df.loc[df["assembly"] == "first", "flags"] = "unusable"
     df.to_csv(modal, index=False)
     mode = unit(workdir / "results", "first")
-    res = snakemake(workdir, "--cores", "2", f"results/calibration/first/{mode}/ga_best.json", *SMALL)  # that GA alone: not the other's too
+    # that GA alone: not the other's too
+    res = snakemake(workdir, "--cores", "2", f"results/calibration/first/{mode}/ga_best.json", *SMALL)
     assert res.returncode != 0
     assert (f"results/modal/first/{mode}/modal_properties.csv: all 12 runs of assembly 'first' are flagged unusable"
             in res.stderr), res.stderr

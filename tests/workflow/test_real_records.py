@@ -17,22 +17,22 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from tests._support.workflow import snakemake, workflow_copy
+from tests._support.workflow import snakemake
 from jointcal.calibrate import DEFAULT_BOUNDS
 from jointcal.posterior.fit import P_REJECT
 from jointcal.report.summary import fmt
 from jointcal.report.verdict import HOLDS_E
 
-REAL = Path(__file__).resolve().parents[2] / "shared" / "real" / "unesp-bert-mode1"
+REAL = Path(__file__).resolve().parents[3] / "shared" / "real" / "unesp-bert-mode1"
 
 pytestmark = [pytest.mark.acceptance,
               pytest.mark.skipif(not (REAL / "manifest.csv").is_file(),
                                  reason=f"the real records are not at {REAL} (they are not part of the repository)")]
 
 
-def test_a_voltage_driven_real_campaign_runs_end_to_end_with_the_default_config(tmp_path):
-    work, out = workflow_copy(tmp_path), tmp_path / "results"
-    res = snakemake(work, "--cores", "2", "--config", f"raw_data={REAL}", f"results={out}")
+def test_a_voltage_driven_real_campaign_runs_end_to_end_with_the_default_config(tmp_path, workdir):
+    out = tmp_path / "results"
+    res = snakemake(workdir, "--cores", "2", "--config", f"raw_data={REAL}", f"results={out}")
     assert res.returncode == 0, res.stderr[-3000:]
     best = json.loads((out / "calibration" / "bert_5Nm" / "m18" / "ga_best.json").read_text())
     assert best["model_kind"] == "modal" and best["excitation"] == "voltage" and best["per_unit_modal_mass"]
