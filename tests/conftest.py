@@ -1,5 +1,6 @@
-"""Shared fixtures: the committed small campaign and a writable copy of it; synthetic campaigns made
-once per session (the exact time simulation of a 24-run campaign takes tens of seconds)."""
+"""Shared fixtures: the committed small campaign and a writable copy of it; two runs of the example campaign
+to break; synthetic campaigns made once per session (the exact time simulation of a 24-run campaign takes tens of
+seconds)."""
 from __future__ import annotations
 
 import shutil
@@ -8,10 +9,12 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from jointcal.synth import generate
-from tests._support.campaign import DEFAULT_SPEC, SMALL_CAMPAIGN, example_copy, voltage_campaign
-from tests._support.ingest import OTHER, RUN
-from tests._support.modal_helpers import modal_table
+pytest.register_assert_rewrite("tests._support")  # the helpers' asserts report as the tests' own do
+
+from jointcal.synth import generate  # noqa: E402
+from tests._support.campaign import DEFAULT_SPEC, SMALL_CAMPAIGN, example_copy, voltage_campaign  # noqa: E402
+from tests._support.ingest import OTHER, RUN  # noqa: E402
+from tests._support.modal_helpers import modal_table  # noqa: E402
 
 
 @pytest.fixture(scope="session")

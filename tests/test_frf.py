@@ -2,14 +2,14 @@
 from __future__ import annotations
 
 import numpy as np
-import pandas as pd
 import pytest
 
-from jointcal.io import CampaignError, read_run, write_run
+from jointcal.io import read_run
 from jointcal.measure.frf import h1_estimate, record_frf, zeta_at_quadrature
 from jointcal.measure.modal import measure_run
 from jointcal.models import G, MinistackModel, simulate
 from jointcal.synth.daq import controlled_sweep
+from tests._support.ingest import _write_csv
 
 F0, ZETA = 100.0, 0.015  # Hz, damping ratio of the linear test structure
 M = 1.0 / G  # 1 lbf weight
@@ -86,10 +86,6 @@ def test_welch_of_one_segment_is_the_ratio_of_transforms():
     np.testing.assert_allclose(H[1:-1], (Y / X)[1:-1], rtol=1e-9)
 
 
-def _write_csv(path, cols: dict) -> None:
-    pd.DataFrame(cols).to_csv(path, index=False, float_format="%.12g")
-
-
 SWEEP_FIT_KEYS = ("f_res_hz", "zeta_res", "q_in", "eta", "f_sweep_hz", "zeta_sweep", "modal_constant_re",
                   "modal_constant_im", "modal_slope_re", "modal_slope_im", "q_peak_in")  # q_peak_in: at f_res_hz
 
@@ -115,26 +111,6 @@ def test_response_in_m_s2_gives_the_same_modal_table(tmp_path):
             assert pb[key] == v or (v != v and pb[key] != pb[key]), key
     assert pa["f_res_method"] == "sweep_fit" and pa["zeta_sweep"] == pytest.approx(ZETA, rel=0.01)
     assert pa["f_res_hz"] == pytest.approx(F0, rel=5e-4) and pa["zeta_frf"] == pytest.approx(ZETA, rel=0.01)
-
-
-@pytest.mark.parametrize("cols, words", [
-    (["time_s", "drive_V", "force_lbf", "response_accel_g"], ["2 reference channels", "drive_V"]),
-    (["time_s", "drive_V", "response_accel_g", "response_accel_m_s2"], ["unexpected", "response_accel_m_s2"]),
-    (["time_s", "drive_V"], ["response_accel_g", "response_accel_m_s2"]),
-])
-def test_reference_and_response_columns_are_checked(tmp_path, cols, words):
-    _write_csv(tmp_path / "r.csv", {c: np.arange(20.0) for c in cols})
-    with pytest.raises(CampaignError) as exc:
-        read_run(tmp_path / "r.csv")
-    assert all(w in str(exc.value) for w in words), str(exc.value)
-
-
-def test_voltage_record_round_trip(tmp_path):
-    t = np.arange(100) / 1000.0
-    write_run(tmp_path / "v.mat", t, np.sin(t), np.cos(t), kind="voltage")
-    df = read_run(tmp_path / "v.mat")
-    assert list(df.columns) == ["time_s", "drive_V", "response_accel_g"]
-    np.testing.assert_allclose(df["drive_V"], np.sin(t))
 
 
 def test_pair_backbone_of_a_linear_frf_is_its_pole():

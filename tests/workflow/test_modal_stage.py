@@ -12,7 +12,7 @@ import pytest
 from jointcal.io import read_manifest, read_run, write_run
 from jointcal.synth import generate
 from tests._support.campaign import edit_manifest
-from tests.test_lab_formats import NAMES, WRITERS
+from tests.io.test_lab_formats import NAMES, WRITERS
 
 
 @pytest.mark.slow

@@ -1,67 +1,26 @@
-"""Lab mistakes: each bad input, built from a clean run of the example campaign (raw_data/) or of a
-synthetic voltage-driven campaign, gets one sentence naming the file, the problem and the fix; a run
-that is still readable is flagged and the others go on, otherwise nothing is written.
+"""A base-driven response's units, from its ratio to the base below resonance
+(jointcal.io._transmissibility): a response in m/s^2 under the g name (or g under the m/s^2 name) flagged at any
+position of a campaign of any size, with one sentence naming the file, the run and the fix; no false positive on
+the example's runs, the library's effects or a second mode at the band's bottom; 'undecided' or 'not checkable'
+said in the run's row when the record cannot tell.
 
-What is left in the results folder is checked through `jointcal ingest CAMPAIGN RESULTS/ingest/runs.csv
---on-data-problem flag` (the workflow's policy; its ingest rule runs the same `ingest_campaign`), and
-through the workflow itself where the workflow adds something (the parse-time manifest check, the
-modal stage's 'unusable').
-"""
+Each bad input is built from a clean run of the example campaign (raw_data/) or of a synthetic campaign, and
+checked through `jointcal ingest CAMPAIGN RESULTS/ingest/runs.csv --on-data-problem flag` (the workflow's policy;
+its ingest rule runs the same `ingest_campaign`)."""
 from __future__ import annotations
 
 import warnings
-import zipfile
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
-import scipy.io
 
-from jointcal.cli import main
 from jointcal.io import CampaignError, CampaignWarning, ingest_campaign, read_manifest, read_run, validate_run
 from jointcal.io._amplitudes import low_frequency_ratio
-from jointcal.io._time import check_time, time_resolution
 from jointcal.units import G_SI  # m/s^2 per g
-from tests._support.campaign import REPO, edit_manifest, edit_run
-from tests._support.ingest import FILE, OTHER, RUN, _scale
-
-
-def _one_sentence(msg: str, *words: str) -> None:
-    assert all(w in msg for w in words), msg
-    assert "\n" not in msg and msg.endswith((".", "?")), msg
-
-
-def _ingest(campaign: Path, capsys) -> tuple[int, str, pd.DataFrame | None]:
-    """Exit status, stderr and runs.csv (None when not written) of `jointcal ingest` into a results folder."""
-    out = campaign.parent / "results" / "ingest" / "runs.csv"
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", CampaignWarning)  # the CLI prints them
-        code = main(["ingest", str(campaign), str(out), "--on-data-problem", "flag"])
-    err = capsys.readouterr().err
-    return code, err, (pd.read_csv(out, keep_default_na=False).set_index("run_id") if out.exists() else None)
-
-
-def _flagged(campaign: Path, capsys, rid: str, flag: str, *words: str) -> pd.DataFrame:
-    """The run gets `flag` and a warning naming `words`; the other runs are clean; runs.csv is written."""
-    code, err, runs = _ingest(campaign, capsys)
-    assert code == 0 and runs is not None, err
-    warned = [line.removeprefix("jointcal: warning: ") for line in err.splitlines() if "warning" in line]
-    assert len(warned) == 1, err
-    _one_sentence(warned[0], *words)
-    assert runs.loc[rid, "flags"].split(";") == [flag]
-    assert (runs.drop(index=rid)["flags"] == "").all()
-    return runs
-
-
-def _stopped(campaign: Path, capsys, *words: str) -> str:
-    """Ingest stops with one sentence naming `words`; no runs.csv is left."""
-    code, err, runs = _ingest(campaign, capsys)
-    lines = err.strip().splitlines()
-    assert code == 2 and runs is None, err
-    assert len(lines) == 1 and lines[0].startswith("jointcal: ") and "Traceback" not in err, err
-    _one_sentence(lines[0], *words)
-    return lines[0]
+from tests._support.campaign import REPO, edit_run
+from tests._support.ingest import FILE, OTHER, RUN, _flagged, _one_sentence, _scale
 
 
 # ------------------------------------------------------------------------ the response's units, base-driven
@@ -273,167 +232,3 @@ def test_a_voltage_driven_response_in_other_units_cannot_be_seen_and_the_contrac
     for doc in (REPO / "README.md", REPO / "raw_data" / "README.md"):
         text = " ".join(doc.read_text().split())
         assert "cannot be checked" in text and "response units on a voltage- or force-driven run" in text, doc
-
-
-# ------------------------------------------------------------------------ the manifest
-
-
-def test_one_record_under_two_spellings_is_one_record(example, capsys):
-    edit_manifest(example, lambda m: pd.concat([m, m.iloc[[0]].assign(run_id="again", sequence="13",
-                                                                        file=f"./{FILE}")]))
-    _stopped(example, capsys, "manifest.csv: lines 2, 4", f"name one file, as '{FILE}' and './{FILE}'",
-             "give each run its own record file")
-
-
-def test_spreadsheet_trailing_empty_rows_are_left_out_with_a_note(example, capsys):
-    with open(example / "manifest.csv", "a") as fh:
-        fh.write(",,,,,,,,,\n" * 3)
-    code, err, runs = _ingest(example, capsys)
-    assert code == 0 and list(runs.index) == [RUN, OTHER] and (runs["flags"] == "").all(), err
-    _one_sentence(err.splitlines()[0].removeprefix("jointcal: warning: "), "manifest.csv: lines 4-6 are empty",
-                  "delete them from the manifest")
-
-
-@pytest.mark.parametrize("where", ["manifest", "run"])
-def test_a_trailing_comma_on_every_line_is_named(example, capsys, where):
-    path = example / ("manifest.csv" if where == "manifest" else FILE)
-    if where == "manifest":
-        lines = path.read_text().splitlines()
-        path.write_text("".join(f"{line},\n" for line in lines))
-    else:
-        read_run(path).to_csv(path, index=False, float_format="%.9g")
-        import gzip
-
-        text = gzip.decompress(path.read_bytes()).decode().splitlines()
-        path.write_bytes(gzip.compress("".join(f"{line},\n" for line in text).encode()))
-    _stopped(example, capsys, path.name, "every line ends with a comma, which adds an empty last column",
-             "remove the trailing commas")
-
-
-def test_trailing_commas_on_the_data_lines_only_are_named(example, capsys):
-    """pandas would silently shift the columns (the first becomes the index)."""
-    path = example / "manifest.csv"
-    lines = path.read_text().splitlines()
-    path.write_text(lines[0] + "\n" + "".join(f"{line},\n" for line in lines[1:]))
-    _stopped(example, capsys, "manifest.csv", "every data line ends with a comma", "remove the trailing commas")
-
-
-@pytest.mark.parametrize("content, words", [
-    ("gzip", ["first_01_1g_up.csv: it is gzip-compressed but named .csv",
-              "rename it first_01_1g_up.csv.gz (also in the manifest's file column) or decompress it"]),
-    ("xlsx", ["first_01_1g_up.csv: it is a zip archive (an Excel workbook?) but named .csv",
-              "save it from the spreadsheet as 'CSV UTF-8 (comma delimited)'"]),
-])
-def test_a_record_that_is_not_csv_text_is_named(example, capsys, content, words):
-    plain = example / "runs" / f"{RUN}.csv"
-    if content == "gzip":
-        (example / FILE).rename(plain)
-    else:
-        with zipfile.ZipFile(plain, "w") as z:
-            z.writestr("xl/workbook.xml", "<workbook/>")
-    edit_manifest(example, lambda m: m.assign(file=m["file"].where(m["run_id"] != RUN, f"runs/{RUN}.csv")))
-    _stopped(example, capsys, *words)
-
-
-@pytest.mark.parametrize("case", ["windows path", "missing file"])
-def test_a_windows_path_or_a_missing_file_is_named_when_the_manifest_is_read(example, capsys, case):
-    if case == "windows path":
-        edit_manifest(example, lambda m: m.assign(file=m["file"].where(m["run_id"] != RUN, f"runs\\{RUN}.csv.gz")))
-        words = [f"manifest.csv: line 2 (run_id '{RUN}'): file 'runs\\{RUN}.csv.gz'", "Windows backslash ('\\')",
-                 f"write it with '/' ({FILE})"]
-    else:
-        (example / FILE).unlink()
-        words = [FILE, f"the file of run '{RUN}' listed in manifest.csv (line 2) does not exist",
-                 "add the file or correct its name"]
-    _stopped(example, capsys, *words)
-
-
-# ------------------------------------------------------------------------ voltage-driven runs
-
-
-def test_a_level_v_typed_ten_times_too_large_is_flagged(voltage, capsys):
-    rid = "beam_01_0.3V_up"
-    edit_manifest(voltage, lambda m: m.assign(level_V=m["level_V"].where(m["run_id"] != rid, "3.0")))
-    _flagged(voltage, capsys, rid, "level:drive_V", "runs/beam_01_0.3V_up.csv.gz: drive amplitude is 0.3 V where "
-             "the manifest says level_V = 3 V", f"correct level_V of run '{rid}' in manifest.csv")
-
-
-def test_a_drive_in_millivolts_is_named(voltage, capsys):
-    rid, file = "beam_02_0.3V_down", "runs/beam_02_0.3V_down.csv.gz"
-    edit_run(voltage, file, _scale("drive_V", 1000.0))
-    _flagged(voltage, capsys, rid, "level:drive_V", file, "is drive_V in mV?", "export drive_V in V (divide by 1000)")
-
-
-def test_swapped_drive_and_response_on_a_voltage_run_are_named(voltage, capsys):
-    rid, file = "beam_01_0.3V_up", "runs/beam_01_0.3V_up.csv.gz"
-    edit_run(voltage, file, lambda d: d.rename(columns={"drive_V": "response_accel_g", "response_accel_g": "drive_V"}))
-    runs = _flagged(voltage, capsys, rid, "swapped:drive_V", file, "the drive voltage is flat",
-                    "the two columns look swapped", "export each channel under its own name")
-    assert runs.loc[rid, "f_first_hz"] == pytest.approx(60.0, abs=2.0)  # the band is read from the true drive
-
-
-def test_a_mat_file_with_other_variable_names_lists_them(voltage, capsys):
-    rid = "beam_01_0.3V_up"
-    df = read_run(voltage / "runs" / f"{rid}.csv.gz")
-    scipy.io.savemat(voltage / "runs" / f"{rid}.mat", {"t": df["time_s"].to_numpy(), "volts": df["drive_V"].to_numpy(),
-                                                       "acc": df["response_accel_g"].to_numpy()})
-    edit_manifest(voltage, lambda m: m.assign(file=m["file"].where(m["run_id"] != rid, f"runs/{rid}.mat")))
-    msg = _stopped(voltage, capsys, f"{rid}.mat: variable 'time_s' is missing", "(the file's variables: t, volts, acc)",
-                   "save the MAT variables time_s,drive_V,response_accel_g")
-    assert "base_accel_g" not in msg and "column" not in msg
-
-
-def test_a_mat_file_without_the_drive_names_the_voltage_channel(voltage, capsys):
-    rid = "beam_01_0.3V_up"
-    df = read_run(voltage / "runs" / f"{rid}.csv.gz")
-    scipy.io.savemat(voltage / "runs" / f"{rid}.mat", {"time_s": df["time_s"].to_numpy(),
-                                                       "response_accel_g": df["response_accel_g"].to_numpy()})
-    edit_manifest(voltage, lambda m: m.assign(file=m["file"].where(m["run_id"] != rid, f"runs/{rid}.mat")))
-    _stopped(voltage, capsys, "variable 'drive_V' (the manifest's level_V makes the run voltage-driven) is missing",
-             "(the file's variables: time_s, response_accel_g)")
-
-
-# ------------------------------------------------------------------------ time
-
-
-def test_jittered_time_is_named(example, capsys):
-    rng = np.random.default_rng(5)
-
-    def jitter(d: pd.DataFrame) -> None:
-        d["time_s"] = d["time_s"] + rng.uniform(-0.1, 0.1, len(d)) / 12800.0  # +/- 10 % of a step per sample
-    edit_run(example, FILE, jitter)
-    _stopped(example, capsys, FILE, "time_s is not evenly spaced", "of a step off a uniform grid",
-             "export the DAQ's own sample times (t0 + i / sample rate)")
-
-
-@pytest.mark.parametrize("fmt, bound", [("%.7g", 5e-6), ("%.5f", 5e-6), ("float32", 2.0**-24 * 60)])
-def test_rounded_times_are_not_jitter(fmt, bound):
-    """A 60 s record at 12.8 kHz written with 7 significant digits or 5 decimals (rounded by up to 6 % of a
-    step), or in float32 (3 %): the way the times were written, not jitter."""
-    t = np.arange(int(60 * 12800)) / 12800.0
-    t = t.astype(np.float32).astype(float) if fmt == "float32" else np.array([float(fmt % v) for v in t])
-    assert time_resolution(t).max() == pytest.approx(bound, rel=0.01)
-    assert check_time(t, 12800.0, "r.csv", "'r'") == pytest.approx(12800.0, rel=1e-6)
-
-
-def _with_head(seconds: float):
-    def edit(d: pd.DataFrame) -> pd.DataFrame:
-        n = int(round(seconds * 12800))
-        rng = np.random.default_rng(2)
-        head = pd.DataFrame({c: 1e-4 * rng.standard_normal(n) for c in ("base_accel_g", "response_accel_g")})
-        out = pd.concat([head, d[["base_accel_g", "response_accel_g"]]], ignore_index=True)
-        return out.assign(time_s=np.arange(len(out)) / 12800.0)[["time_s", "base_accel_g", "response_accel_g"]]
-    return edit
-
-
-def test_a_silent_pre_trigger_head_is_named_and_sweep_start_s_reads_the_run(example, capsys):
-    edit_run(example, FILE, _with_head(0.25))
-    _stopped(example, capsys, FILE, "the drive starts 0.25 s after the record's first sample (a silent pre-trigger "
-             "head of 3200 samples)", "trim the head", f"sweep_start_s column (0.25 for run '{RUN}')")
-    edit_manifest(example, lambda m: m.assign(sweep_start_s=np.where(m["run_id"] == RUN, "0.25", "")))
-    code, err, runs = _ingest(example, capsys)
-    assert code == 0 and (runs["flags"] == "").all(), err
-    assert runs.loc[RUN, "f_first_hz"] == pytest.approx(700.0, abs=5.0)
-    assert runs.loc[RUN, "sweep_start_s"] == 0.25 and runs.loc[OTHER, "sweep_start_s"] == 0.0
-    row = read_manifest(example / "manifest.csv").iloc[0]
-    assert len(read_run(example / FILE, row)) == len(read_run(REPO / "raw_data" / FILE))

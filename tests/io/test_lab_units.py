@@ -13,21 +13,17 @@ import pandas as pd
 import pytest
 import pyuff
 import scipy.io
-from tests._support.campaign import REPO, edit_manifest
 
 from jointcal.io import CampaignError, ingest_campaign, read_manifest, read_run
 from jointcal.io._lab_channels import lab_channels
 from jointcal.units import G_SI, INCH_M, LBF_N  # m/s^2 per g, m per inch, N per lbf
+from tests._support.campaign import REPO, edit_manifest
+from tests._support.ingest import _one_sentence
 
 REAL = Path(os.environ.get("JOINTCAL_REAL_DATA", REPO.parent / "shared" / "real")) / "unesp-bert-dwell-mode1"
 TERMS = ("LENGTH", "ANGLE", "MASS", "TIME", "CURRENT", "LIGHT", "TEMPERATURE", "MOLCULAR_AMOUNT")
 DIMS = {"acceleration": {"LENGTH": 1, "TIME": -2}, "voltage": {"LENGTH": 2, "MASS": 1, "TIME": -3, "CURRENT": -1},
         "time": {"TIME": 1}, "force": {"LENGTH": 1, "MASS": 1, "TIME": -2}}
-
-
-def _one_sentence(msg: str, *words: str) -> None:
-    assert all(w in msg for w in words), msg
-    assert "\n" not in msg and msg.endswith((".", "?")), msg
 
 
 # ------------------------------------------------------------------------ the lab's own Test.Lab exports
@@ -240,4 +236,3 @@ def test_a_uff_label_that_disagrees_with_its_exponents_is_named(voltage):
 def test_a_uff_label_that_agrees_with_its_exponents_is_read(voltage):
     path, row, df = _as_lab_run(voltage, ".uff", lambda p, d: write_uff_units(p, d, 1, response_label="m/s^2"))
     np.testing.assert_allclose(read_run(path, row)["response_accel_g"], df["response_accel_g"], rtol=1e-12)
-

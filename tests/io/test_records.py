@@ -1,23 +1,20 @@
-"""Tests of jointcal.io: readers, validation against a known campaign, atomic writers."""
+"""Records and campaigns (jointcal.io._records): the contract's CSV and MAT read back exactly, a
+campaign ingested against a known sweep, and every malformed record or manifest one sentence naming the file."""
 from __future__ import annotations
 
 import importlib.util
-import json
-import os
+import shutil
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 import scipy.io
-from tests._support.campaign import DATA, edit_manifest, edit_run
 
-from jointcal.io._clipping import clip_levels
-from jointcal.io import (
-    CampaignError, CampaignWarning, ingest_campaign, read_manifest, read_run, validate_run,
-    write_bytes_atomic, write_csv_atomic, write_json_atomic, write_run,
-)
+from jointcal.io import CampaignError, CampaignWarning, ingest_campaign, listed_record, read_run, write_run
+from tests._support.campaign import DATA, edit_manifest, edit_run
+from tests._support.ingest import _stopped, _write_csv
+
 
 # ------------------------------------------------------------------------ readers
 
@@ -46,20 +43,6 @@ def test_force_driven_round_trip(tmp_path):
     np.testing.assert_allclose(got["force_lbf"], np.sin(t), rtol=1e-8)
 
 
-def test_write_run_rejects_bad_input(tmp_path):
-    with pytest.raises(ValueError, match="one length"):
-        write_run(tmp_path / "a.csv", [0.0, 1.0], [0.0], [0.0, 1.0])
-    with pytest.raises(ValueError, match="suffix"):
-        write_run(tmp_path / "a.txt", [0.0], [0.0], [0.0])
-
-
-def test_manifest_types(small_campaign):
-    m = read_manifest(small_campaign / "manifest.csv")
-    assert list(m["run_id"]) == ["run01", "run02", "run03", "run04", "run05"]
-    assert m["sequence"].dtype == np.int64 and m["level_g"].dtype == np.float64
-    assert set(m["direction"]) == {"up", "down"}
-
-
 def test_committed_campaign_matches_generator(tmp_path, small_campaign):
     spec = importlib.util.spec_from_file_location("make_small_campaign", DATA / "make_small_campaign.py")
     gen = importlib.util.module_from_spec(spec)
@@ -86,26 +69,6 @@ def test_clean_campaign_recovers_known_sweep(small_campaign):
     # a 0.7 s sweep of amplitude level in a 0.75 s record: rms = level / sqrt(2) * sqrt(0.7 / 0.75)
     expected = runs["level_g"] / np.sqrt(2) * np.sqrt(0.7 / 0.75)
     np.testing.assert_allclose(runs["rms_base_accel_g"], expected, rtol=0.02)
-
-
-def test_free_decay_tail_is_accepted(small_campaign):
-    row = read_manifest(small_campaign / "manifest.csv").iloc[1]  # a down sweep
-    df = read_run(small_campaign / row["file"])
-    n_tail = 4000  # 0.31 s more of silence after the sweep
-    tail = pd.DataFrame({"time_s": df["time_s"].iloc[-1] + np.arange(1, n_tail + 1) / 12800.0,
-                         "base_accel_g": 0.0, "response_accel_g": 0.0})
-    checks = validate_run(pd.concat([df, tail], ignore_index=True), row, "long.csv")
-    assert checks["n_samples"] == len(df) + n_tail
-    assert abs(checks["f_last_hz"] - 1500.0) < 5.0
-
-
-def test_clip_levels_finds_both_limits():
-    x = np.sin(np.linspace(0, 6 * np.pi, 600))
-    x = np.clip(x, -0.9, 0.95)
-    levels = clip_levels(x, 3)
-    assert [v for v, _, _ in levels] == [0.95, -0.9]
-    assert [n for _, n, _ in levels] == [np.count_nonzero(x == 0.95), np.count_nonzero(x == -0.9)]
-    assert clip_levels(np.sin(np.arange(1000.0)), 3) == []
 
 
 # ------------------------------------------------------------------------ malformed campaigns
@@ -242,64 +205,57 @@ def test_flag_mode_still_raises_structural_problems(campaign):
         ingest_campaign(campaign, on_data_problem="flag")
 
 
-def test_clean_data_with_repeated_nonextreme_values_is_not_clipped(small_campaign):
-    row = read_manifest(small_campaign / "manifest.csv").iloc[0]
-    df = read_run(small_campaign / row["file"])
-    df.loc[1000:1009, "response_accel_g"] = 0.0  # a dropout at zero is not clipping
-    assert validate_run(df, row, "x.csv")["flags"] == []
+def test_duplicate_basenames_keep_their_own_records(campaign):
+    """Two folders may hold files of one name: each run gets its own record."""
+    for rid, folder in (("run01", "a"), ("run02", "b")):
+        (campaign / folder).mkdir()
+        shutil.move(campaign / f"{rid}.csv.gz", campaign / folder / "run.csv.gz")
+        edit_manifest(campaign, lambda m, r=rid, f=folder: m.assign(
+            file=m["file"].where(m["run_id"] != r, f"{f}/run.csv.gz")))
+    runs = ingest_campaign(campaign).set_index("run_id")
+    assert runs.loc["run01", "f_first_hz"] < 1600 < runs.loc["run02", "f_first_hz"]  # up vs down: each its own file
+    paths = [str(campaign / f) for f in runs["file"]]
+    assert listed_record("a/run.csv.gz", paths) == str(campaign / "a" / "run.csv.gz")
+    assert listed_record("b/run.csv.gz", paths) == str(campaign / "b" / "run.csv.gz")
+    assert listed_record("a/run.csv.gz", [str(campaign / "b" / "a" / "run.csv.gz"), paths[0]]) == paths[0]
 
 
-# ------------------------------------------------------------------------ atomic writers
+def test_a_mat_file_with_other_variable_names_lists_them(voltage, capsys):
+    rid = "beam_01_0.3V_up"
+    df = read_run(voltage / "runs" / f"{rid}.csv.gz")
+    scipy.io.savemat(voltage / "runs" / f"{rid}.mat", {"t": df["time_s"].to_numpy(), "volts": df["drive_V"].to_numpy(),
+                                                       "acc": df["response_accel_g"].to_numpy()})
+    edit_manifest(voltage, lambda m: m.assign(file=m["file"].where(m["run_id"] != rid, f"runs/{rid}.mat")))
+    msg = _stopped(voltage, capsys, f"{rid}.mat: variable 'time_s' is missing", "(the file's variables: t, volts, acc)",
+                   "save the MAT variables time_s,drive_V,response_accel_g")
+    assert "base_accel_g" not in msg and "column" not in msg
 
 
-def _listing(folder: Path) -> list[str]:
-    return sorted(p.name for p in folder.iterdir())
+def test_a_mat_file_without_the_drive_names_the_voltage_channel(voltage, capsys):
+    rid = "beam_01_0.3V_up"
+    df = read_run(voltage / "runs" / f"{rid}.csv.gz")
+    scipy.io.savemat(voltage / "runs" / f"{rid}.mat", {"time_s": df["time_s"].to_numpy(),
+                                                       "response_accel_g": df["response_accel_g"].to_numpy()})
+    edit_manifest(voltage, lambda m: m.assign(file=m["file"].where(m["run_id"] != rid, f"runs/{rid}.mat")))
+    _stopped(voltage, capsys, "variable 'drive_V' (the manifest's level_V makes the run voltage-driven) is missing",
+             "(the file's variables: time_s, response_accel_g)")
 
 
-def test_atomic_writers_create_parents_and_leave_no_temp(tmp_path):
-    df = pd.DataFrame({"a": [1.5, 2.0], "b": ["x", "y"]})
-    out = write_csv_atomic(df, tmp_path / "deep" / "er" / "t.csv")
-    pd.testing.assert_frame_equal(pd.read_csv(out), df)
-    write_json_atomic({"x": np.float64(1.5), "v": np.arange(3), "p": Path("a/b")}, tmp_path / "deep" / "j.json")
-    assert json.loads((tmp_path / "deep" / "j.json").read_text()) == {"x": 1.5, "v": [0, 1, 2], "p": "a/b"}
-    write_bytes_atomic(b"abc", tmp_path / "deep" / "b.bin")
-    write_bytes_atomic(b"new", tmp_path / "deep" / "b.bin")
-    assert (tmp_path / "deep" / "b.bin").read_bytes() == b"new"
-    assert _listing(tmp_path / "deep") == ["b.bin", "er", "j.json"]
-    umask = os.umask(0)
-    os.umask(umask)
-    assert out.stat().st_mode & 0o777 == 0o666 & ~umask
+@pytest.mark.parametrize("cols, words", [
+    (["time_s", "drive_V", "force_lbf", "response_accel_g"], ["2 reference channels", "drive_V"]),
+    (["time_s", "drive_V", "response_accel_g", "response_accel_m_s2"], ["unexpected", "response_accel_m_s2"]),
+    (["time_s", "drive_V"], ["response_accel_g", "response_accel_m_s2"]),
+])
+def test_reference_and_response_columns_are_checked(tmp_path, cols, words):
+    _write_csv(tmp_path / "r.csv", {c: np.arange(20.0) for c in cols})
+    with pytest.raises(CampaignError) as exc:
+        read_run(tmp_path / "r.csv")
+    assert all(w in str(exc.value) for w in words), str(exc.value)
 
 
-def test_json_writer_failing_midway_keeps_old_file(tmp_path):
-    target = tmp_path / "state.json"
-    target.write_text('{"old": true}\n')
-    with pytest.raises(TypeError):
-        write_json_atomic({"a": list(range(1000)), "b": object()}, target)
-    assert target.read_text() == '{"old": true}\n'
-    assert _listing(tmp_path) == ["state.json"]
-
-
-def test_csv_writer_failing_midway_keeps_old_file(tmp_path, monkeypatch):
-    target = tmp_path / "runs.csv"
-    target.write_text("old\n")
-
-    def broken_to_csv(self, fh, **kwargs):
-        fh.write("half a ta")
-        raise OSError("disk full")
-
-    monkeypatch.setattr(pd.DataFrame, "to_csv", broken_to_csv)
-    with pytest.raises(OSError, match="disk full"):
-        write_csv_atomic(pd.DataFrame({"a": [1]}), target)
-    assert target.read_text() == "old\n"
-    assert _listing(tmp_path) == ["runs.csv"]
-
-
-def test_clipped_mask_marks_exactly_the_clipped_samples():
-    from jointcal.io._clipping import clipped_mask
-
-    x = np.sin(np.linspace(0, 20 * np.pi, 2000)) * 1.3
-    y = np.clip(x, -1.0, 1.1)  # asymmetric limits
-    mask = clipped_mask(y)
-    np.testing.assert_array_equal(mask, (y == 1.1) | (y == -1.0))
-    assert not clipped_mask(x).any()
+def test_voltage_record_round_trip(tmp_path):
+    t = np.arange(100) / 1000.0
+    write_run(tmp_path / "v.mat", t, np.sin(t), np.cos(t), kind="voltage")
+    df = read_run(tmp_path / "v.mat")
+    assert list(df.columns) == ["time_s", "drive_V", "response_accel_g"]
+    np.testing.assert_allclose(df["drive_V"], np.sin(t))

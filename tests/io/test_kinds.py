@@ -98,7 +98,7 @@ def test_sweeps_are_the_default_and_read_as_before(tmp_path, test):
 
 def _testlab_pair(folder, rid, rec):
     """A run exported as Test.Lab does it: the response in <rid>_Time.mat, the drive apart in <rid>_TimeShaker.mat."""
-    from tests.test_lab_formats import write_testlab
+    from tests.io.test_lab_formats import write_testlab
 
     folder.mkdir(parents=True, exist_ok=True)
     write_testlab(folder / f"{rid}_Time.mat", rec[["time_s", "response_accel_g"]], {"response_accel_g": "g"})
@@ -106,7 +106,7 @@ def _testlab_pair(folder, rid, rec):
 
 
 def test_a_drive_exported_apart_is_read_from_reference_file(tmp_path, records):
-    from tests.test_lab_formats import NAMES
+    from tests.io.test_lab_formats import NAMES
 
     lab = tmp_path / "lab"
     for rid, rec in (("d18", "d18"), ("d20", "d20"), ("r20", "d20")):
