@@ -1,4 +1,15 @@
-"""Modal stage: resonance and damping against known truth, flags, scatter, force-driven runs."""
+"""Modal stage (jointcal.measure.modal): resonance and damping against known truth, flags,
+scatter, force-driven runs, and one backbone whatever the sweep.
+
+One backbone whatever the sweep: force- and voltage-driven virtual rigs with a second mode. A jointed 100 Hz beam
+with a linear 230 Hz mode at the driving point, on an open-loop shaker (`tests/_support/rigs.py`), read by the
+modal stage: each run's (q_in, f_res_hz, zeta_res) against the truth's curve at its own q_in (the structure's
+first-harmonic balance for a force, the coupled rig's pole for a voltage), and q_in against the amplitude the
+mode reached. The full matrix (eta 0.5-500, up and down, three seeds) is tests/benchmarks/accept_backbone.py; here
+a chirp at eta 5 that crosses both modes, an impulse-like one at eta 500 and a slow sweep at eta 0.5, with 2%
+noise, at two levels."""
+from __future__ import annotations
+
 from pathlib import Path
 
 import numpy as np
@@ -12,9 +23,8 @@ from jointcal.measure.scatter import scatter
 from jointcal.models import G, IwanParams, MinistackModel, harmonic_balance, simulate
 from jointcal.synth import generate
 from jointcal.synth.daq import controlled_sweep
+from tests._support import rigs as _rigs
 from tests._support.modal_helpers import against_truth, modal_table
-
-pytestmark = pytest.mark.slow
 
 
 @pytest.fixture(scope="module")
@@ -24,6 +34,7 @@ def default_campaign(default_campaign_dir, default_modal):
     return table, against_truth(table, default_campaign_dir.parent / "truth.json")
 
 
+@pytest.mark.slow
 def test_resonance_and_damping_match_truth(default_campaign):
     table, err = default_campaign
     f_err, z_err, hp_err = err["f_err"].abs(), err["zeta_err"].abs(), err["zeta_hp_err"]
@@ -38,6 +49,7 @@ def test_resonance_and_damping_match_truth(default_campaign):
     assert (table["f_res_method"] == "quadrature").all()
 
 
+@pytest.mark.slow
 def test_up_and_down_agree_within_scatter(default_campaign):
     """No direction bias: up/down differences are as scattered as the repeats, centred on 0.
 
@@ -65,6 +77,7 @@ def test_up_and_down_agree_within_scatter(default_campaign):
 FIRST = {"Fs": 313.0, "KT": 1.02e6, "chi": -0.65, "beta": 0.004, "k": 6.12e5, "zeta_v": 0.0015}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("rate, method", [(2000.0, "quadrature_slope"), (12000.0, "frf_fit")])
 def test_fast_sweep_flags_eta_and_keeps_resonance_unbiased(tmp_path, rate, method):
     generate({"seed": 2, "sweep": {"f_start_hz": 1500.0, "f_stop_hz": 2700.0, "rate_hz_per_s": rate},
@@ -78,6 +91,7 @@ def test_fast_sweep_flags_eta_and_keeps_resonance_unbiased(tmp_path, rate, metho
     assert err["f_err"].abs().max() < (1e-3 if method == "quadrature_slope" else 2e-3)
 
 
+@pytest.mark.slow
 def test_channel_delay_shifts_quadrature_as_2_pi_f_tau_predicts(tmp_path):
     tau = 40e-6
     spec = {"seed": 4, "sweep": {"f_start_hz": 1500.0, "f_stop_hz": 2700.0, "rate_hz_per_s": 150.0},
@@ -151,6 +165,7 @@ def force_driving_point(tmp_path_factory):
     return model, env, out
 
 
+@pytest.mark.slow
 def test_force_driven_driving_point(force_driving_point):
     model, env, out = force_driving_point
     p = model.iwan
@@ -173,6 +188,7 @@ def test_force_driven_driving_point(force_driving_point):
     assert env["drive_on"].iloc[-20:].eq(False).all()  # the free decay is not taken for drive
 
 
+@pytest.mark.slow
 def test_force_driven_remote_sensor_gives_the_mode_at_its_own_amplitude(tmp_path, force_driving_point):
     """A sensor near a node (2% of the slug's motion) dominated by other modes' mass line: the envelope
     phase never reaches quadrature, and the swept-mode fit takes the mass line as its residual term and
@@ -192,6 +208,7 @@ def test_force_driven_remote_sensor_gives_the_mode_at_its_own_amplitude(tmp_path
     assert remote["modal_constant_re"] == pytest.approx(0.02 / model.m, rel=0.03)
     assert remote["q_in"] / 0.02 == pytest.approx(driving["q_in"], rel=0.03)
 
+@pytest.mark.slow
 def test_a_run_is_read_with_the_config_modal_section_as_the_later_stages_pass_it(tmp_path):
     """Validation and discrepancy read one run at a time with the config's whole `modal` section
     (measure_run): its campaign-level switches (coil, on or off) do not reach the one-run read-out, which
@@ -211,3 +228,19 @@ def test_a_run_is_read_with_the_config_modal_section_as_the_later_stages_pass_it
         props = measure_run(record, row, modal_kw={**section, "coil": coil})[2]
         assert props["f_res_method"] == plain["f_res_method"] == "sweep_fit"
         assert props["f_res_hz"] == plain["f_res_hz"] and props["zeta_res"] == plain["zeta_res"]
+
+
+@pytest.mark.parametrize("ref, eta, direction", [("voltage", 5.0, "up"), ("force", 500.0, "down"),
+                                                 ("voltage", 500.0, "up"), ("force", 0.5, "up")])
+def test_read_outs_lie_on_the_truths_backbone(tmp_path, ref, eta, direction):
+    levels = _rigs.levels_V()
+    _rigs.campaign(tmp_path / "c", tmp_path / "t.json", ref=ref, eta=eta, direction=direction, seed=2,
+                   levels=[levels[0], levels[2]])
+    r = _rigs.read_out(tmp_path / "c", tmp_path / "t.json", ref)
+    print("\n" + r[["method", "eta", "q_in", "f_err", "zeta_err", "q_err", "q_peak_err"]].to_string())
+    assert (r["method"] == "sweep_fit").all() and (r["flags"] == "").all()
+    assert r["eta"].min() > 0.2 * eta
+    assert np.abs(r["f_err"]).max() < 1e-3
+    assert np.abs(r["zeta_err"]).max() < 0.05
+    assert np.abs(r["q_err"]).max() < 0.03
+    assert r["q_in"].iloc[1] > 2 * r["q_in"].iloc[0]  # the levels reach different amplitudes

@@ -101,7 +101,7 @@ def test_the_coil_sensitivities_are_the_central_difference_of_the_same_model(fre
     Richardson-extrapolated central difference of the misfit itself, column by column: the coil's two new
     directions (its corner and back-EMF gain) and every other one through the coil's third state, at an
     amplitude-dependent point, from a fitted moving start (the coil's forced start depends on it) and from rest."""
-    from tests.test_sweepfit import _force_chirp
+    from tests.measure.test_sweepfit import _force_chirp
 
     from jointcal.models import MinistackModel
 

@@ -3,24 +3,17 @@ import numpy as np
 import pytest
 from scipy.integrate import quad_vec
 
-from tests._support.lockin import demodulate, linear_sweep, quadrature
-from jointcal.models import G, Fixture, IwanParams, MinistackModel, harmonic_balance, qsma
-from jointcal.models import contact_spring, resonance_amplitude, simulate
+from jointcal.models import (
+    G, Fixture, IwanParams, MinistackModel, contact_spring, harmonic_balance, qsma, resonance_amplitude, simulate,
+)
 from jointcal.models.simulate import fractional_delay, hermite_propagator
 from jointcal.models.sliders import slider_set
-from jointcal.models.structure import can_spring, state_space
+from jointcal.models.structure import state_space
+from tests._support.lockin import demodulate, linear_sweep, quadrature
 
 M = 2.65 / G
 TABLE_3_2 = MinistackModel(m=M, k=6.12e5, zeta_v=0.0015, iwan=IwanParams(313, 1.02e6, -0.65, 0.004))
 P = dict(Fs=313.0, KT=1.02e6, chi=-0.65, beta=0.004, k=6.12e5, m=M, zeta_v=0.0015)
-
-
-def test_can_spring_gives_the_can_its_own_frequency_and_damping_ratio():
-    """sqrt(k_can / m_can) = 2 pi f_can and c_can / (2 sqrt(k_can m_can)) = zeta_can, per parameter set."""
-    m, f, z = np.array([0.004, 0.01]), np.array([4000.0, 5500.0]), 0.02
-    k, c = can_spring(m, f, z)
-    np.testing.assert_allclose(np.sqrt(k / m) / (2 * np.pi), f, rtol=1e-14)
-    np.testing.assert_allclose(c / (2 * np.sqrt(k * m)), z, rtol=1e-14)
 
 
 def test_hermite_propagator_matches_quadrature():
