@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from jointcal.calibrate import select_modal
 from jointcal.models import G, resonance_amplitude
 
 LEVELS = (1, 1, 1, 1, 1, 1, 2, 2, 5, 5, 10, 10)  # Table 3.1, g
@@ -86,3 +87,9 @@ def write_tables(folder, truths, **kw):
     scatter.to_csv(d / "scatter.csv", index=False)
     backbone_table(with_modes(modal), []).to_csv(d / "backbone.csv", index=False)
     return d / "modal_properties.csv", d / "scatter.csv"
+
+
+def _data(truth=TABLE_3_2["first"], seed=1, noise=(2e-4, 0.01)):
+    """The calibration's data (`select_modal`) of assembly 'first' from `modal_tables` of `truth`."""
+    modal, scatter = modal_tables({"first": truth}, rel_noise=noise, seed=seed)
+    return select_modal(modal, "first", scatter=scatter)
