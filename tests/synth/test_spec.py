@@ -1,11 +1,25 @@
-"""The virtual lab's spec (jointcal.synth.spec): a malformed spec file is one sentence
-naming it, and nothing is written."""
+"""The virtual lab's spec (jointcal.synth.spec): a bad spec, given as a mapping or a file, is
+one sentence, and nothing is written."""
 from __future__ import annotations
 
 import pytest
 
 from jointcal.cli import main
+from jointcal.synth import generate, load_spec
 from tests._support.ingest import _one_sentence
+
+FIRST = {"Fs": 313.0, "KT": 1.02e6, "chi": -0.65, "beta": 0.004, "k": 6.12e5, "zeta_v": 0.0015}
+
+
+def test_spec_errors_are_one_sentence(tmp_path):
+    with pytest.raises(ValueError, match="seed"):
+        load_spec({"assemblies": {"a": FIRST}})
+    with pytest.raises(ValueError, match="unknown hidden effect"):
+        load_spec({"seed": 1, "effect": {"name": "gremlins"}})
+    with pytest.raises(ValueError, match="too low"):
+        load_spec({"seed": 1, "sample_rate_hz": 4000.0})
+    with pytest.raises(ValueError, match="must not live inside"):
+        generate({"seed": 1}, tmp_path / "c", tmp_path / "c" / "truth.json")
 
 
 @pytest.mark.parametrize("text, words", [

@@ -5,6 +5,8 @@ time: it reaches the virtual lab, the envelope model, the time simulation and th
 workflow with no other file touched. Oracles: the Duffing oscillator's closed forms (its
 free-vibration period by quadrature of the energy, its first-harmonic amplitude equation).
 """
+from __future__ import annotations
+
 import importlib
 import json
 import pkgutil
@@ -22,7 +24,7 @@ from jointcal.calibrate.space import PARAMS
 from jointcal.effects import EFFECTS, Effect, EffectParam, library, register
 from jointcal.models import G, MinistackModel, simulate, steady_state
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 M = 2.65 / G
 TOY = '''
 """foam_spring: a hardening foam pad beside the joint, k_foam z^3 (a toy effect for the tests)."""
@@ -177,3 +179,9 @@ def test_toy_effect_runs_through_synth_and_diagnose(toy, tmp_path):
     assert abs(k_foam / 2e12 - 1) < 0.05
     assert d["rule"] and d["rule_applied"] and all(c in d["rule"] for c in d["rule_applied"])
     assert set(PARAMS) <= set(d["baseline"]["joint_parameters"])
+
+
+def test_each_kind_tries_its_own_library():
+    assert set(library("modal")) == {"channel_delay", "cubic_stiffening", "joint_settling", "elastic_softening",
+                                     "neighbour_mode"}
+    assert "sensor_gain" in library("ministack") and "elastic_softening" not in library("ministack")

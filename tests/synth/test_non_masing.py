@@ -24,7 +24,7 @@ from jointcal.synth.non_masing import blended_force, equivalent, first_harmonic,
 P = IwanParams(4.0, 204.0, -0.5, 0.1)  # the jointed beam of tests/_rigs.py: phi_max 0.0498 in
 BEAM = {"k": 818.0, "Fs": 4.0, "KT": 204.0, "chi": -0.5, "beta": 0.1, "zeta_v": 0.008, "weight_lbf": 1.0}
 SHAKER = {"armature_weight_lbf": 0.05, "suspension_hz": 15.0, "bl_lbf_per_A": 0.5, "coil_ohm": 2.0, "coil_mH": 0.3}
-CONFIG = Path(__file__).parents[1] / "workflow" / "config" / "config.yaml"
+CONFIG = Path(__file__).parents[2] / "workflow" / "config" / "config.yaml"
 
 
 @pytest.mark.parametrize("s", [0.0, 0.3, 0.7])

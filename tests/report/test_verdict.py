@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from jointcal.report.verdict import first_answer, identified_html, verdict_items
+from jointcal.report.verdict import first_answer, identified_html, named_effects, verdict_html, verdict_items
 
 BEST = {"model_kind": "modal", "excitation": "voltage"}
 NOT_APPLICABLE = {"recommended": None, "reason": "This campaign is voltage-driven.", "applicable": False,
@@ -89,3 +89,56 @@ def test_an_unsettled_chain_identifies_nothing_and_the_page_says_what_to_run():
     assert "Settle the posterior first" in a4 and "0.625" not in a4
     page = identified_html(t, title="t")
     assert "not from this chain alone" in page and "max_steps: 333000" in page and "left to the bounds" not in page
+
+
+def _identified_k0():
+    rows = [dict(quantity=p, unit="-", kind="parameter", log=p != "chi", q_in=np.nan, q05=v / 2, median=v, q95=2 * v,
+                 free_share=0.0 if ok else 1.0, identified=ok, fixed_directions=4.0)
+            for p, v, ok in (("Fs", 300.0, False), ("KT", 1e6, False), ("chi", -0.6, True), ("beta", 0.01, False),
+                             ("k", 6e5, False), ("zeta_v", 0.0015, True))]
+    rows.append(dict(quantity="K0", unit="lbf/in", kind="combination", log=True, q_in=np.nan, q05=1.62e6,
+                     median=1.63e6, q95=1.64e6, free_share=0.0, identified=True, fixed_directions=4.0))
+    return pd.DataFrame(rows)
+
+
+@pytest.mark.parametrize("newer", [False, True])
+def test_verdict_answers_in_order_and_reads_either_form_of_the_diagnosis(newer):
+    diag = {"effect": "fixture_flexibility", "confidence": "high", "metric_before": 17.13, "metric_after": 0.41,
+            "recalibrated": {"joint_parameters": {p: {"value": v, "interval_90": sorted([0.9 * v, 1.1 * v])} for p, v in
+                                                  (("Fs", 75.7), ("KT", 6.5e5), ("chi", -0.637), ("beta", 0.076),
+                                                   ("k", 8.9e5), ("zeta_v", 0.00176))},
+                             "effect_parameters": {"f_can_hz": {"value": 5617.0, "unit": "Hz",
+                                                                "interval_90": [5602.0, 5624.0]}}}}
+    if newer:
+        diag["effects"] = ["fixture_flexibility"]
+    nxt = {"recommended": {"level_g": 100.0, "direction": "up", "sweep_rate_hz_per_s": 1200.0, "duration_s": 1.5},
+           "targets": ["Fs", "KT/k"], "share_of_draws_identifying_targets": 0.16, "identifies_targets": False,
+           "confidence": 0.9, "max_level_g": 100.0, "width_now": {"Fs": 1.59, "KT/k": 2.3},
+           "predicted_width_ratio_if_identified": {"Fs": 18.3, "KT/k": 14.6},
+           "predicted_width_ratio": {"Fs": 1.6, "KT/k": 1.4}}
+    corrected = {"Fs": False, "KT": False, "chi": True, "beta": False, "k": False, "zeta_v": True}
+    items = verdict_items(best={"model_kind": "ministack", "excitation": "base"}, identified=_identified_k0(),
+                          validation={"E": 17.13}, fit={"fit_chi2": 306.7, "fit_dof": 18.0, "fit_p": 2e-54},
+                          diagnosis=diag, next_test=nxt, corrected=corrected)
+    (q1, a1), (q2, a2), (q3, a3), (q4, a4) = items
+    assert "reproduce" in q1 and "<b>No</b>" in a1 and "17.13" in a1 and "p = 2e-54" in a1
+    assert "fixture_flexibility" in a2 and "<b>17.13</b> to <b>0.41</b>" in a2 and "5617" in a2
+    assert "chi -0.637 [-0.701, -0.573]" in a3 and "zeta_v 0.00176" in a3
+    assert "75.7" not in a3 and "6.5e5" not in a3 and "8.9e5" not in a3  # free directions: no value
+    assert "Left to the bounds (no value is given): Fs, KT, beta, k" in a3
+    assert "100 g base sweep, up, at 1200 Hz/s" in a4 and "16%" in a4 and "width ratio 18.3" in a4
+    page = verdict_html({"first": items})
+    assert page.index("reproduce") < page.index("discrepancy") < page.index("identify") < page.index("next test")
+    assert named_effects({"effect": "none"}) == [] and named_effects({"effects": ["a", "b"], "effect": "a+b"}) == ["a", "b"]
+
+
+def test_verdict_without_a_named_effect_reports_the_paper_models_identified_quantities():
+    items = verdict_items(best={"model_kind": "modal", "excitation": "force"}, identified=_identified_k0(),
+                          validation={"E": 1.3}, fit={"fit_chi2": 20.0, "fit_dof": 18.0, "fit_p": 0.33},
+                          next_test={"recommended": None, "reason": "This campaign is force-driven.",
+                                     "what_would_identify": "A response amplitude past macroslip."})
+    a1, a2, a3, a4 = (a for _, a in items)
+    assert "<b>Yes</b>" in a1 and "agree with" in a1
+    assert a2 == "The discrepancy stage did not run."  # it runs for every excitation: absent only when not run
+    assert "K0 = k + KT 1.63e6 [1.62e6, 1.64e6] lbf/in" in a3 and "Fs" in a3.split("Left to the bounds")[1]
+    assert "No level recommended" in a4 and "force-driven" in a4
