@@ -7,7 +7,8 @@ import pandas as pd
 
 from jointcal.models import G, IwanParams, MinistackModel
 
-BEAM = MinistackModel(m=1.0 / G, k=818.0, zeta_v=0.008, iwan=IwanParams(4.0, 204.0, -0.5, 0.1))  # tests/_rigs.py
+# the jointed beam of tests/_support/rigs.py
+BEAM = MinistackModel(m=1.0 / G, k=818.0, zeta_v=0.008, iwan=IwanParams(4.0, 204.0, -0.5, 0.1))
 FS, F0, F1, RATE = 2048.0, 50.0, 150.0, 4.0  # the chirp starts and stops outside the fitted band (0.6-1.4 f_res)
 GAINS = {"force": (complex(G), 0j, 2 * np.pi * 100.0),  # 1/m at the driving point, real, no slope
          "voltage": (complex(300.0, -150.0), complex(0.9, 0.6), 2 * np.pi * 100.0)}  # an amplifier's, sloped

@@ -15,7 +15,7 @@ REPO = Path(__file__).parents[2]
 EXAMPLE = REPO / "raw_data"
 # the default generator (no hidden effect) with the seed the session's default campaign is made with (conftest.py)
 DEFAULT_SPEC = {"seed": 7}
-# a 1 lbf, 100 Hz linear beam on an open-loop shaker, only the amplifier voltage recorded (tests/test_rigs.py)
+# a 1 lbf, 100 Hz linear beam on an open-loop shaker, only the amplifier voltage recorded (tests/synth/test_shaker.py)
 BEAM = {"k": 1022.0, "zeta_v": 0.015, "weight_lbf": 1.0}
 SHAKER = {"armature_weight_lbf": 0.05, "suspension_hz": 15.0, "bl_lbf_per_A": 0.5, "coil_ohm": 2.0, "coil_mH": 0.3}
 VOLTAGE_SPEC = {"seed": 8, "sample_rate_hz": 1024.0,

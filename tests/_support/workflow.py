@@ -43,5 +43,5 @@ def snakemake(work: Path, *args: str) -> subprocess.CompletedProcess[str]:
 def _edit(path: Path) -> str:
     """Append a comment to a module (a change to its text, not to what it does); return the original."""
     text = path.read_text()
-    path.write_text(text + "\n# edited by test_workflow_mechanics\n")
+    path.write_text(text + "\n# edited by a test (tests/_support/workflow.py)\n")
     return text

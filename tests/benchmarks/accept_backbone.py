@@ -2,7 +2,7 @@
 
 Run:  python tests/benchmarks/accept_backbone.py [--quick]
 
-The jointed 100 Hz beam of `tests/_rigs.py` (a second, linear mode at 230 Hz at the driving
+The jointed 100 Hz beam of `tests/_support/rigs.py` (a second, linear mode at 230 Hz at the driving
 point; a small open-loop shaker with its electrical dynamics) at three drive levels, swept
 at eta 0.5, 5, 50 and 500 (slow sweeps over +-30% of the mode; faster ones over 30-260 Hz,
 the second mode included), up and down, with 2% noise, seeds 1-3, for both references.

@@ -4,7 +4,7 @@ Five campaigns from the virtual lab with truths drawn around Table 3.2 (first as
 raw records -> envelopes -> modal table (the real estimators) -> GA -> emcee. Counts the
 (parameter, campaign) pairs the data constrain whose 90% interval holds the truth; passes
 when at least 15 pairs are constrained and >= 80% are covered. Two campaigns at a time.
-(Moved out of the CI suite for time: ~7 min on 2 cores; test_posterior keeps a coverage
+(Moved out of the CI suite for time: ~7 min on 2 cores; tests/posterior/test_stage.py keeps a coverage
 test on idealised modal tables.)
 
     python tests/benchmarks/accept_pipeline_coverage.py

@@ -2,7 +2,7 @@
 
 Run:  python tests/benchmarks/bench_sweep_jacobian.py [--blas-threads N] [--repeats K]
 
-The force- and voltage-driven jointed-beam rigs of `accept_backbone.py --quick` (`tests/_rigs.py`: three
+The force- and voltage-driven jointed-beam rigs of `accept_backbone.py --quick` (`tests/_support/rigs.py`: three
 levels, up sweeps, seed 1, 2% noise) at eta 0.5 and 5. Each run is read by the modal stage
 (`jointcal.measure.modal.measure_run`) twice in turn, with the sweep fit's Jacobian by forward
 differences (`jacobian='2-point'`, the baseline: the scheme before) and by forward sensitivities

@@ -86,4 +86,4 @@ def test_level_mistakes_are_left_out_of_the_calibration():
                           "flags": ["", "level:base_accel_g", "swapped:base_accel_g;bad_samples",
                                     "clipped:response_accel_g"]})
     data = select_modal(modal, "first")
-    assert data.run_id == ("r1",)  # clipped: the peak is missing, damping biased high (see below)
+    assert data.run_id == ("r1",)  # clipped: the peak is missing, damping biased high (see tests/io/test_clipping.py)

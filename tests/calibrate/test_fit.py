@@ -42,7 +42,7 @@ def test_five_seeds_reach_the_same_optimum():
 def test_calibrated_curves_match_the_truth(eta, f_tol):
     """(b) on the GA's eq. 3.9 optimum. With eta = 0.85 (the paper) the 1% damping noise outweighs the
     0.02% frequency noise in eq. 3.9 and pulls the frequency curve off by up to ~0.1%; eta = 0.99
-    meets 0.05%. (The posterior, which weights by the noise, is checked against 0.05% in test_posterior.)"""
+    meets 0.05%. (The posterior, which weights by the noise, is checked against 0.05% in posterior/test_stage.py.)"""
     d = _data()
     cal = calibrate(d, CalibrateSettings.from_config({"eta": eta}))
     theta = np.array([cal.best[p] for p in PARAMS])

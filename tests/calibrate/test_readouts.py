@@ -9,7 +9,6 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from tests._support.modal_tables import TABLE_3_2, modal_tables
 
 from jointcal.calibrate import CalibrateSettings, objective, read_modal, run_calibration, select_modal
 from jointcal.io import ingest_campaign, read_run, write_csv_atomic
@@ -23,6 +22,7 @@ from jointcal.posterior import PosteriorSettings, run_posterior
 from jointcal.posterior.identified import identified_table, quantities
 from jointcal.synth import DEFAULT_SPEC, generate
 from jointcal.units import G
+from tests._support.modal_tables import TABLE_3_2, modal_tables
 
 FIRST = TABLE_3_2["first"]
 M = DEFAULT_SPEC["slug_weight_lbf"] / G

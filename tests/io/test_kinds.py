@@ -4,10 +4,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 import pytest
-from tests._support.campaign import EXAMPLE, example_copy, edit_manifest
-from tests._support.kinds_records import dwell_row, kinds_campaign, linear_dwell
 
 from jointcal.io import CampaignError, ingest_campaign, read_manifest, read_run
+from tests._support.campaign import EXAMPLE, example_copy, edit_manifest
+from tests._support.kinds_records import dwell_row, kinds_campaign, linear_dwell
 
 
 def _one_sentence(msg: str, *words: str) -> None:

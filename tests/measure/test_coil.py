@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from tests._support.jacobian import assert_matches_central_difference
 from jointcal.measure._coil import coil_pole
 from jointcal.measure._rotating import demodulate, passage
 from jointcal.measure._sweep_problem import NP, Problem
 from jointcal.measure.sweepfit import fit_swept_mode
 from jointcal.units import G
+from tests._support.jacobian import assert_matches_central_difference
 
 
 def _cardano(a: float, b: float, c: float) -> np.ndarray:

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from tests._support.kinds_records import FN, ZETA, linear_dwell, linear_frf
 
 from jointcal.measure.dwell import dwell_mode, dwell_point
 from jointcal.models import IwanParams, MinistackModel, harmonic_balance, simulate
 from jointcal.units import G
+from tests._support.kinds_records import FN, ZETA, linear_dwell, linear_frf
 
 JOINT = dict(k=818.0, Fs=4.0, KT=204.0, chi=-0.5, beta=0.1, zeta_v=0.008, m=1.0 / G)  # a 100 Hz jointed beam
 

@@ -2,7 +2,7 @@
 band holds (jointcal.measure.modes, jointcal.measure.campaign).
 
 Truths: closed-form FRFs of linear modes (the peaks), and a virtual force-driven structure with two
-amplitude-dependent modes integrated by the exact Iwan simulator (tests/_two_modes.py), whose read-outs
+amplitude-dependent modes integrated by the exact Iwan simulator (tests/_support/two_modes.py), whose read-outs
 are held against each mode's first-harmonic balance at the amplitude the run reached.
 """
 from __future__ import annotations
@@ -10,13 +10,13 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 import pytest
-from tests._support.two_modes import campaign, truth
 
 from jointcal._workflow import modal_units
 from jointcal.io import read_manifest, read_run
 from jointcal.measure.campaign import campaign_modal
 from jointcal.measure.envelopes import envelopes
 from jointcal.measure.modes import modal_peaks, mode_name, track_modes
+from tests._support.two_modes import campaign, truth
 
 
 def _receptance(f, modes):
@@ -99,7 +99,7 @@ def test_two_amplitude_dependent_modes_each_read_at_its_own_backbone(two_modes):
 
 @pytest.mark.slow
 def test_a_voltage_driven_chirp_over_two_modes_reads_each(tmp_path):
-    """The jointed beam of tests/_rigs.py on its open-loop shaker (the coil, the armature, a second, linear
+    """The jointed beam of tests/_support/rigs.py on its open-loop shaker (the coil, the armature, a second, linear
     mode at 230 Hz), chirped over both modes at eta 50 with 2% noise: both modes found in every run; the
     jointed one on the coupled rig's pole at its q_in (0.1%, 5%), the linear one at one frequency and
     damping whatever the level."""

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from tests._support.jacobian import assert_matches_central_difference
 from jointcal.measure.sweepfit import fit_swept_mode
 from jointcal.models import G, IwanParams, MinistackModel, harmonic_balance, simulate
 from jointcal.synth.daq import controlled_sweep
+from tests._support.jacobian import assert_matches_central_difference
 
 
 def _force_chirp(model: MinistackModel, f_lo: float, f_hi: float, rate: float, fs: float, force: float,

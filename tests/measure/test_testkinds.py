@@ -5,12 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 import pytest
-from tests._support.kinds_records import FN, ZETA, dwell_row, kinds_campaign, linear_dwell
 
 from jointcal.io import ingest_campaign, read_run
 from jointcal.measure.campaign import campaign_modal
 from jointcal.measure.scatter import scatter
 from jointcal.measure.testkinds import BACKBONE_COLUMNS, backbone_table
+from tests._support.kinds_records import FN, ZETA, dwell_row, kinds_campaign, linear_dwell
 
 FREQS = (19.3, 19.9, 20.2, 20.5, 21.1)
 

@@ -3,11 +3,11 @@ import numpy as np
 import pytest
 from scipy.signal import fftconvolve
 
-from tests._support.lockin import linear_sweep
 from jointcal.models.envelope import _structure_terms
 from jointcal.models import (
     G, Fixture, IwanParams, MinistackModel, cubic_spring, dissipation, harmonic_balance, simulate, steady_state,
 )
+from tests._support.lockin import linear_sweep
 
 M = 2.65 / G
 IWAN = IwanParams(313.0, 1.02e6, -0.65, 0.004)  # Table 3.2, first assembly

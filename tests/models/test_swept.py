@@ -8,10 +8,10 @@ the exact-Iwan time simulation (`simulate`) demodulated by an independent Hann l
 import numpy as np
 import pytest
 
-from tests._support.lockin import linear_sweep
 from jointcal.models import (
     G, Fixture, IwanParams, MinistackModel, SweepDrive, quasi_steady, simulate, steady_state, swept_transmissibility,
 )
+from tests._support.lockin import linear_sweep
 
 M = 2.65 / G
 IWAN = IwanParams(313.0, 1.02e6, -0.65, 0.004)  # Table 3.2, first assembly

@@ -1,13 +1,13 @@
 """What the data identify (jointcal.posterior.identified), against draws along the microslip null manifold
-built by hand from eqs. 3.5 and 3.7 (tests/_microslip.py), and against read-outs past macroslip."""
+built by hand from eqs. 3.5 and 3.7 (tests/_support/microslip.py), and against read-outs past macroslip."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
-from tests._support.microslip import M, PARAMS, TRUTH, model_readouts, null_draws, readouts
 
 from jointcal.calibrate import CalibrateSettings
 from jointcal.posterior.identified import fisher, fixed_directions, free_share, identified_at, identified_table
+from tests._support.microslip import M, PARAMS, TRUTH, model_readouts, null_draws, readouts
 
 SPACE = CalibrateSettings().space
 NAMES = [*PARAMS, "sigma_f", "sigma_zeta"]

@@ -2,7 +2,7 @@
 
 Known truths: read-outs on a smooth backbone plus relative noise of a chosen size; runs of two modes
 interleaved over the same amplitudes; a chain's convergence state and mode labels set by hand; draws
-past macroslip that identify every parameter when the chain has settled (tests/test_identified.py).
+past macroslip that identify every parameter when the chain has settled (tests/posterior/test_identified.py).
 """
 from __future__ import annotations
 
@@ -11,7 +11,6 @@ from dataclasses import replace
 import numpy as np
 import pandas as pd
 import pytest
-from tests._support.microslip import M, PARAMS, TRUTH, readouts
 
 from jointcal.calibrate import CalibrateSettings
 from jointcal.calibrate.data import ModalData
@@ -19,6 +18,7 @@ from jointcal.posterior import LogPosterior
 from jointcal.posterior.identified import identified_table, unsettled
 from jointcal.posterior.identified import settled as settled_table
 from jointcal.posterior.noise import data_problem, noise_scale, readout_noise
+from tests._support.microslip import M, PARAMS, TRUTH, readouts
 
 SPACE = CalibrateSettings().space
 FLOORS = {"frequency": 1e-4, "damping": 0.01}

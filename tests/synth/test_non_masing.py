@@ -21,7 +21,7 @@ from jointcal.models import state_space
 from jointcal.posterior.fit import P_REJECT
 from jointcal.synth.non_masing import blended_force, equivalent, first_harmonic, with_share
 
-P = IwanParams(4.0, 204.0, -0.5, 0.1)  # the jointed beam of tests/_rigs.py: phi_max 0.0498 in
+P = IwanParams(4.0, 204.0, -0.5, 0.1)  # the jointed beam of tests/_support/rigs.py: phi_max 0.0498 in
 BEAM = {"k": 818.0, "Fs": 4.0, "KT": 204.0, "chi": -0.5, "beta": 0.1, "zeta_v": 0.008, "weight_lbf": 1.0}
 SHAKER = {"armature_weight_lbf": 0.05, "suspension_hz": 15.0, "bl_lbf_per_A": 0.5, "coil_ohm": 2.0, "coil_mH": 0.3}
 CONFIG = Path(__file__).parents[2] / "workflow" / "config" / "config.yaml"

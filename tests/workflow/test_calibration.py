@@ -13,11 +13,11 @@ import numpy as np
 import pandas as pd
 import pytest
 import yaml
+
+from jointcal.models import harmonic_balance
 from tests._support.campaign import unit
 from tests._support.modal_tables import M, TABLE_3_2, write_tables
 from tests._support.workflow import snakemake
-
-from jointcal.models import harmonic_balance
 
 pytestmark = pytest.mark.slow
 

@@ -34,7 +34,7 @@ def test_workflow_keeps_the_nan_warning_when_an_error_follows(tmp_path, campaign
 @pytest.mark.slow
 def test_workflow_keeps_a_units_mistake_out_of_the_modal_fit(tmp_path, campaign, workdir):
     """Flagged before calibration: a record in m/s^2 reaches modal_properties.csv as unusable
-    (select_modal leaves it out; a wrong level takes the same path, see the tests above). Its file
+    (select_modal leaves it out; a wrong level takes the same path, see tests/io/test_amplitudes.py). Its file
     and a clean run's file share a basename in two folders (2 runs: CI time)."""
     edit_run(campaign, "run03.csv.gz", _si)
     edit_manifest(campaign, lambda m: m[m["run_id"].isin(["run01", "run03"])])

@@ -17,11 +17,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from tests._support.workflow import snakemake
 from jointcal.calibrate import DEFAULT_BOUNDS
 from jointcal.posterior.fit import P_REJECT
 from jointcal.report.summary import fmt
 from jointcal.report.verdict import HOLDS_E
+from tests._support.workflow import snakemake
 
 REAL = Path(__file__).resolve().parents[3] / "shared" / "real" / "unesp-bert-mode1"
 

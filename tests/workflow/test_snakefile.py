@@ -10,14 +10,15 @@ import numpy as np
 import pandas as pd
 import pytest
 import yaml
+
 from tests._support.campaign import REPO, edit_run, unit
 from tests._support.workflow import snakemake, workflow_copy
 
 pytestmark = pytest.mark.slow
 
 
-# light settings: these tests check the wiring and the reruns; test_calibrate, test_posterior, test_validate and
-# test_discrepancy check the methods
+# light settings: these tests check the wiring and the reruns; tests/calibrate, posterior, validate and
+# discrepancy check the methods
 SMALL = {"calibrate": {"population": 20, "offspring": 20, "generations": 3, "n_polish": 0},
          "posterior": {"max_steps": 100, "chunk": 100, "predictive_draws": 10}, "validate": {"n_draws": 2}}
 
@@ -129,7 +130,7 @@ def test_default_config_runs_on_the_example_campaign(workdir, tmp_path):
     (workdir / "raw_data").symlink_to(REPO / "raw_data")
     out = tmp_path / "results"
     # a short posterior and a lighter validation/discrepancy: this test checks the wiring (and that the
-    # example's hidden can flexibility is named); test_posterior and test_discrepancy check the methods
+    # example's hidden can flexibility is named); tests/posterior and tests/discrepancy check the methods
     (workdir / "short.yaml").write_text("posterior: {max_steps: 2000, chunk: 500}\nvalidate: {n_draws: 2}\n"
                                         "discrepancy: {candidates: [sensor_gain, channel_delay, fixture_flexibility], "
                                         "max_nfev: 15, ga_generations: 5, posterior_steps: 200}\n")
