@@ -9,7 +9,6 @@ Snakemake schedules, not what they compute (test_snakefile.py runs them for real
 from __future__ import annotations
 
 import re
-import shutil
 import subprocess
 from pathlib import Path
 
@@ -161,11 +160,7 @@ def test_typo_in_config_is_one_line_before_any_schema_dump(touched):
 def test_slurm_profile_dry_run_has_one_job_per_assembly_and_mode(tmp_path, touched):
     """On the example campaign (24 runs, 2 assemblies) up to the modal checkpoint, whose table names the
     (assembly, mode) jobs after it; their resources on the touched small campaign, with the profile's values."""
-    work = tmp_path / "wf"
-    work.mkdir()
-    shutil.copy(REPO / "Snakefile", work)
-    shutil.copytree(REPO / "workflow", work / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
-    shutil.copytree(REPO / "src" / "jointcal", work / "src" / "jointcal", ignore=shutil.ignore_patterns("__pycache__"))
+    work = workflow_copy(tmp_path, src=True)
     slurm = ["--workflow-profile", "workflow/profiles/slurm"]
     res = snakemake(work, "-n", *slurm, "--config", f"raw_data={REPO / 'raw_data'}", f"results={tmp_path / 'results'}")
     assert "workflow/profiles/slurm" in res.stderr + res.stdout
