@@ -1,5 +1,6 @@
-"""Shared fixtures: the committed small campaign and a writable copy of it; synthetic campaigns made
-once per session (the exact time simulation of a 24-run campaign takes tens of seconds)."""
+"""Shared fixtures: the committed small campaign and a writable copy of it; two runs of the example campaign
+to break; synthetic campaigns made once per session (the exact time simulation of a 24-run campaign takes tens of
+seconds)."""
 from __future__ import annotations
 
 import shutil
@@ -7,10 +8,13 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
-from _campaign import DEFAULT_SPEC, SMALL_CAMPAIGN, voltage_campaign
-from _modal_helpers import modal_table
 
-from jointcal.synth import generate
+pytest.register_assert_rewrite("tests._support")  # the helpers' asserts report as the tests' own do
+
+from jointcal.synth import generate  # noqa: E402
+from tests._support.campaign import DEFAULT_SPEC, SMALL_CAMPAIGN, example_copy, voltage_campaign  # noqa: E402
+from tests._support.ingest import OTHER, RUN  # noqa: E402
+from tests._support.modal_helpers import modal_table  # noqa: E402
 
 
 @pytest.fixture(scope="session")
@@ -52,3 +56,9 @@ def default_modal(default_campaign_dir: Path) -> pd.DataFrame:
     """The modal stage's table of `default_campaign_dir` (every run through `jointcal.modal.measure_run`);
     a copy per use is the caller's to make before editing it."""
     return modal_table(default_campaign_dir)
+
+
+@pytest.fixture
+def example(tmp_path: Path) -> Path:
+    """Two clean runs of the example campaign, to break the first."""
+    return example_copy(tmp_path / "campaign", RUN, OTHER)

@@ -4,12 +4,13 @@ from __future__ import annotations
 import subprocess
 import sys
 
+import numpy as np
 import pandas as pd
-import pytest
-from _campaign import edit_run
 
 from jointcal import __version__
 from jointcal.cli import main
+from tests._support.campaign import edit_run
+from tests._support.ingest import _one_sentence, _set
 
 
 def _cli(*args: str) -> subprocess.CompletedProcess[str]:
@@ -54,3 +55,32 @@ def test_version_and_usage():
     res = _cli("--version")
     assert res.returncode == 0 and res.stdout.strip() == f"jointcal {__version__}"
     assert _cli().returncode == 2
+
+
+def test_ingest_refuses_to_overwrite_an_input(campaign, capsys):
+    before = (campaign / "manifest.csv").read_bytes()
+    assert main(["ingest", str(campaign), str(campaign / "manifest.csv")]) == 2
+    err = capsys.readouterr().err
+    _one_sentence(err.strip(), "manifest.csv: OUT_CSV is an input of the campaign", "write the table elsewhere")
+    assert (campaign / "manifest.csv").read_bytes() == before
+    assert main(["ingest", str(campaign), str(campaign / "run05.mat")]) == 2
+
+
+def test_ingest_to_a_folder_is_one_sentence(campaign, capsys):
+    assert main(["ingest", str(campaign), str(campaign)]) == 2
+    err = capsys.readouterr().err
+    _one_sentence(err.strip(), "OUT_CSV is a folder", "runs.csv")
+    assert "Traceback" not in err
+
+
+def test_cli_keeps_the_warnings_before_an_error(tmp_path, campaign):
+    edit_run(campaign, "run01.csv.gz", _set("base_accel_g", np.nan))
+    edit_run(campaign, "run03.csv.gz", lambda d: d.drop(columns="response_accel_g"))
+    out = tmp_path / "runs.csv"
+    res = subprocess.run([sys.executable, "-m", "jointcal.cli", "ingest", str(campaign), str(out),
+                          "--on-data-problem", "flag"], capture_output=True, text=True)
+    lines = res.stderr.splitlines()
+    assert res.returncode == 2 and len(lines) == 2 and "Traceback" not in res.stderr
+    assert lines[0].startswith("jointcal: warning: ") and "run01.csv.gz" in lines[0] and "NaN" in lines[0]
+    assert lines[1].startswith("jointcal: ") and "run03.csv.gz" in lines[1]
+    assert not out.exists()

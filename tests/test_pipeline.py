@@ -1,11 +1,11 @@
 """End to end on campaigns from the virtual lab: raw records -> envelopes -> modal -> GA -> posterior.
 
-The calibration tests in test_calibrate/test_posterior feed idealised modal tables; here
+The calibration tests in calibrate/ and posterior/ feed idealised modal tables; here
 the tables come from the real estimators on default-generator campaigns (DAQ chain,
 0.3% noise, 300 Hz/s), and the result is checked against the truth that made the data.
 The coverage of the posterior's intervals over five such campaigns (seven minutes) is an
 acceptance script, tests/benchmarks/accept_pipeline_coverage.py; the CI suite keeps
-test_posterior's coverage test on idealised tables.
+posterior/test_stage.py's coverage test on idealised tables.
 """
 import json
 import multiprocessing
@@ -43,7 +43,7 @@ def _calibrate(args):
 
 
 def test_default_campaign_calibrates_to_the_truths_curves(tmp_path, default_campaign_dir, default_modal):
-    """The session's default campaign (conftest.py; its modal table shared with test_modal)."""
+    """The session's default campaign (conftest.py; its modal table shared with measure/test_modal.py)."""
     table, truth = _measure(tmp_path, default_campaign_dir, default_modal)
     jobs = [(tmp_path / "modal_properties.csv", asm, tmp_path / asm) for asm in ("first", "reassembly")]
     with multiprocessing.get_context("fork").Pool(2) as pool:  # the two GA runs are independent

@@ -1,172 +1,104 @@
-"""Run the Snakemake workflow on the small campaign from a copy of the repository's workflow."""
+"""jointcal._workflow, the workflow's parse-time helpers: a stage's code hash follows its imports
+(an edit of measure/peaks.py reruns no stage before modal), and a config key or value given wrong is named in
+one line."""
 from __future__ import annotations
 
-import json
 import re
-import subprocess
-import sys
+import shutil
 from pathlib import Path
 
-import numpy as np
-import pandas as pd
-import pytest
-import yaml
-from _campaign import REPO, edit_run, workflow_copy, unit
+from jointcal import _workflow
+from jointcal._workflow import config_problem, stage_sources
+from tests._support.campaign import REPO
+from tests._support.workflow import _edit
 
-pytestmark = pytest.mark.slow
-
-
-@pytest.fixture
-def workdir(tmp_path: Path) -> Path:
-    """A copy of Snakefile, workflow/ and profiles/ (the working directory of each run)."""
-    return workflow_copy(tmp_path)
+SCRIPTS = REPO / "workflow" / "scripts"
+SCHEMA = REPO / "workflow" / "schemas" / "config.schema.yaml"
 
 
-def _snakemake(work: Path, *args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "snakemake", *args], cwd=work, capture_output=True, text=True,
-                          timeout=900)
+def _names(files: list[Path]) -> set[str]:
+    return {f.relative_to(REPO / "src" / "jointcal").as_posix() for f in files[1:]}
 
 
-# light settings: these tests check the wiring and the reruns; test_calibrate, test_posterior, test_validate and
-# test_discrepancy check the methods
-SMALL = {"calibrate": {"population": 20, "offspring": 20, "generations": 3, "n_polish": 0},
-         "posterior": {"max_steps": 100, "chunk": 100, "predictive_draws": 10}, "validate": {"n_draws": 2}}
+def test_stage_sources_follow_imports_through_the_package():
+    assert stage_sources(SCRIPTS / "modal.py")[0] == SCRIPTS / "modal.py"  # the script's own text counts too
+    modal = _names(stage_sources(SCRIPTS / "modal.py"))
+    assert {"measure/modal.py", "measure/envelopes.py", "io/__init__.py", "io/_checks.py", "__init__.py"} <= modal
+    assert not any(n.startswith(("calibrate/", "posterior/", "report/")) for n in modal)
+    assert "measure/modal.py" not in _names(stage_sources(SCRIPTS / "ingest.py"))
+    assert "measure/modal.py" not in _names(stage_sources(SCRIPTS / "envelopes.py"))
+    # `from ..calibrate.space import ...` in report/calibration.py, and the packages' __init__ files
+    figures = _names(stage_sources(SCRIPTS / "calibration_figures.py"))
+    assert {"report/__init__.py", "report/calibration.py", "calibrate/__init__.py", "calibrate/space.py"} <= figures
 
 
-@pytest.fixture(scope="module")
-def small_run(tmp_path_factory, small_campaign) -> tuple[Path, Path, subprocess.CompletedProcess[str]]:
-    """One workflow copy and one run on the small campaign, shared by the tests below: a bare `snakemake
-    validate` (no --cores: the default profile) with light settings (small.yaml). Each test that edits
-    small.yaml puts it back."""
-    tmp = tmp_path_factory.mktemp("small_run")
-    work = workflow_copy(tmp)
-    (work / "small.yaml").write_text(yaml.safe_dump(SMALL))
-    out = tmp / "results"
-    res = _snakemake(work, "validate", "--configfile", "small.yaml", "--config", f"raw_data={small_campaign}",
-                     f"results={out}")
-    return work, out, res
+def test_an_edit_of_measure_peaks_changes_no_stage_hash_before_modal(tmp_path, monkeypatch):
+    """The hash the rules pass as params (common.smk's source_hash: `stage_hash` of the script), on a copy of the
+    package whose measure/peaks.py is edited: ingest, envelopes and the kernels keep theirs, modal's changes."""
+    before_modal = [re.search(r'script:\s*"\.\./scripts/(\w+\.py)"', block).group(1)
+                    for smk in ("ingest", "envelopes", "kernels")
+                    for block in re.split(r"(?m)^(?=rule )", (REPO / "workflow" / "rules" / f"{smk}.smk").read_text())
+                    if "script:" in block]
+    assert {"ingest.py", "envelopes.py", "kernels.py"} <= set(before_modal)
+    pkg = tmp_path / "jointcal"
+    shutil.copytree(REPO / "src" / "jointcal", pkg, ignore=shutil.ignore_patterns("__pycache__"))
+    monkeypatch.setattr(_workflow, "_ROOT", pkg.resolve())
+    hashes = {s: _workflow.stage_hash(SCRIPTS / s) for s in [*before_modal, "modal.py"]}
+    _edit(pkg / "measure" / "peaks.py")
+    assert {s: _workflow.stage_hash(SCRIPTS / s) for s in before_modal} == {s: hashes[s] for s in before_modal}
+    assert _workflow.stage_hash(SCRIPTS / "modal.py") != hashes["modal.py"]  # the hash does see the edit
 
 
-def _again(small_run, small_campaign, *args: str) -> subprocess.CompletedProcess[str]:
-    work, out, _ = small_run
-    return _snakemake(work, "--cores", "2", *args, "--configfile", "small.yaml", "--config",
-                      f"raw_data={small_campaign}", f"results={out}")
+def test_typo_in_a_nested_key_names_the_nearest_valid_key():
+    config = {"raw_data": "raw_data", "calibrate": {"bounds": {"Fs": [1, 10]}, "populaton": 40}}
+    msg = config_problem(config, SCHEMA)
+    assert msg is not None and "\n" not in msg
+    assert "'calibrate.populaton'" in msg and "did you mean 'calibrate.population'?" in msg
+    assert "did you mean 'resul" in config_problem({"resuls": "out"}, SCHEMA)
 
 
-def test_ingest_rule_tabulates_every_run(small_run, small_campaign):
-    _, out, res = small_run
-    assert res.returncode == 0, res.stderr
-    runs = pd.read_csv(out / "ingest" / "runs.csv")
-    manifest = pd.read_csv(small_campaign / "manifest.csv")
-    assert list(runs["run_id"]) == list(manifest["run_id"])
-    assert "ingested 5 runs" in (out / "logs" / "ingest.log").read_text()
+def test_nested_config_given_as_text_is_converted_or_named_in_one_line():
+    config = {"posterior": {"ball": "0.005", "rel_std_floor": {"frequency": "1e-3"}},  # as --config leaves them
+              "calibrate": {"bounds": {"Fs": ["1", "100"]}, "model": "qsma"}}
+    assert config_problem(config, SCHEMA) is None
+    assert config["posterior"]["ball"] == 0.005 and config["posterior"]["rel_std_floor"]["frequency"] == 1e-3
+    assert config["calibrate"]["bounds"]["Fs"] == [1, 100] and config["calibrate"]["model"] == "qsma"
+    msg = config_problem({"posterior": {"ball": "small"}}, SCHEMA)
+    assert msg.startswith("config 'posterior.ball': 'small' is not of type 'number'")
+    assert "--configfile my.yaml" in msg and "\n" not in msg
 
 
-def test_bare_run_uses_default_profile(small_run):
-    _, out, res = small_run
-    assert res.returncode == 0, res.stderr
-    assert "profiles/default" in res.stderr + res.stdout
-    assert (out / "ingest" / "runs.csv").is_file()
+def _settings(node, path=()):
+    """Every leaf setting of a config (path, value), a list being one setting."""
+    if isinstance(node, dict) and node:
+        for k, v in node.items():
+            yield from _settings(v, (*path, k))
+    else:
+        yield path, node
 
 
-def test_validate_stage_reruns_only_itself_on_a_config_edit(small_run, small_campaign):
-    """`snakemake validate` on the small campaign; then -n: nothing; an edit of validate: only it."""
-    work, out, res = small_run
-    assert res.returncode == 0, res.stderr
-    summary = json.loads((out / "validation" / "first" / unit(out, "first") / "summary.json").read_text())
-    assert np.isfinite(summary["E"]) and "peak response" in summary["words"]
-    metrics = pd.read_csv(out / "validation" / "first" / unit(out, "first") / "metrics.csv")
-    assert len(metrics) == 5 and (metrics["n_frames"] > 0).all()
-    assert (out / "figures" / "fig3_11_validation.png").stat().st_size > 10_000
-    assert "validation envelope error E" in (out / "logs" / "validate" / "first" / f"{unit(out, 'first')}.log").read_text()
-    assert "Nothing to be done" in _again(small_run, small_campaign, "-n", "validate").stdout
-    edited = {**SMALL, "validate": {"n_draws": 3}}
-    (work / "small.yaml").write_text(yaml.safe_dump(edited))
-    try:
-        dry = _again(small_run, small_campaign, "-n", "validate").stdout
-    finally:
-        (work / "small.yaml").write_text(yaml.safe_dump(SMALL))
-    assert "validate_assembly" in dry and "calibrate_assembly" not in dry and "posterior_assembly" not in dry
+def test_every_setting_given_on_the_command_line_as_the_readme_shows_is_read_as_its_value():
+    """Each setting of config.yaml given as ``--config 'section={key: value}'`` (Snakemake's own parser,
+    which leaves nested values as text) is read back as the value the config file gives, or stops in one
+    sentence; a list-or-null setting (modal.mode_hz) takes a number, a list and null."""
+    import yaml
+    from snakemake.cli import parse_config
+    from snakemake.utils import update_config
 
-
-def test_discrepancy_target_runs_that_stage_alone_on_top(small_run, small_campaign):
-    """`snakemake discrepancy` (light settings) after the validation runs that stage alone and writes its outputs."""
-    work, out, res = small_run
-    assert res.returncode == 0, res.stderr
-    light = {**SMALL, "discrepancy": {"candidates": ["sensor_gain", "channel_delay"], "max_nfev": 8,
-                                      "max_frames": 24, "ga_generations": 2, "posterior_steps": 100}}
-    (work / "small.yaml").write_text(yaml.safe_dump(light))
-    try:
-        res = _again(small_run, small_campaign, "discrepancy")
-    finally:
-        (work / "small.yaml").write_text(yaml.safe_dump(SMALL))
-    assert res.returncode == 0, res.stderr
-    ran = set(re.findall(r"rule (\w+):", res.stdout + res.stderr))
-    assert ran == {"discrepancy_assembly", "discrepancy_table", "discrepancy"}, ran
-    d = json.loads((out / "discrepancy" / "first" / unit(out, "first") / "diagnosis.json").read_text())
-    assert d["effect"] in {"sensor_gain", "channel_delay", "none", "unexplained"}
-    assert np.isfinite(d["metric_before"]) and np.isfinite(d["metric_after"]) and "emcee" in d["recalibrated"]["method"]
-    assert (out / "discrepancy" / "first" / unit(out, "first") / "diagnosis.md").read_text().startswith("# Discrepancy diagnosis")
-    assert "<table>" in (out / "discrepancy" / "table_3_2_corrected.html").read_text()
-
-
-def test_malformed_campaign_fails_naming_the_file(workdir, tmp_path, campaign):
-    edit_run(campaign, "run03.csv.gz", lambda d: d.rename(columns={"response_accel_g": "resp_g"}))
-    out = tmp_path / "results"
-    res = _snakemake(workdir, "--cores", "2", "ingest", "--config", f"raw_data={campaign}", f"results={out}")
-    assert res.returncode != 0
-    assert "run03.csv.gz: column 'response_accel_g' is missing" in res.stderr
-    assert "run03.csv.gz" in (out / "logs" / "ingest.log").read_text()
-    assert not (out / "ingest" / "runs.csv").exists()
-
-
-def test_missing_manifest_is_one_clear_line(workdir, tmp_path):
-    res = _snakemake(workdir, "-n", "--cores", "2", "--config", f"raw_data={tmp_path / 'nowhere'}")
-    assert res.returncode != 0
-    assert "nowhere/manifest.csv: the campaign manifest does not exist" in res.stderr
-    assert "Traceback" not in res.stderr and "File " not in res.stderr
-
-
-def test_lint_reports_only_the_expected_conda_advice(workdir, small_campaign, tmp_path):
-    res = _snakemake(workdir, "--lint", "--config", f"raw_data={small_campaign}", f"results={tmp_path / 'r'}")
-    items = [line.strip() for line in (res.stdout + res.stderr).splitlines() if line.strip().startswith("* ")]
-    assert items, res.stdout + res.stderr  # snakemake --lint always asks for conda (STYLE.md trap 4)
-    assert set(items) == {"* Specify a conda environment or container for each rule.:"}, res.stdout + res.stderr
-
-
-@pytest.mark.acceptance
-def test_default_config_runs_on_the_example_campaign(workdir, tmp_path):
-    """`snakemake --cores 2` with the default raw_data/ (linked into the copy) runs every stage."""
-    (workdir / "raw_data").symlink_to(REPO / "raw_data")
-    out = tmp_path / "results"
-    # a short posterior and a lighter validation/discrepancy: this test checks the wiring (and that the
-    # example's hidden can flexibility is named); test_posterior and test_discrepancy check the methods
-    (workdir / "short.yaml").write_text("posterior: {max_steps: 2000, chunk: 500}\nvalidate: {n_draws: 2}\n"
-                                        "discrepancy: {candidates: [sensor_gain, channel_delay, fixture_flexibility], "
-                                        "max_nfev: 15, ga_generations: 5, posterior_steps: 200}\n")
-    res = _snakemake(workdir, "--cores", "2", "--configfile", "short.yaml", "--config", f"results={out}")
-    assert res.returncode == 0, res.stderr
-    runs = pd.read_csv(out / "ingest" / "runs.csv")
-    assert len(runs) == 24 and runs["flags"].isna().all()
-    assert set(runs["assembly"]) == {"first", "reassembly"}
-    modal = pd.read_csv(out / "modal" / "modal_properties.csv")
-    assert len(modal) == 24 and modal["f_res_hz"].notna().all()
-    assert (out / "figures" / "fig3_5_envelopes.png").is_file()
-    for asm in ("first", "reassembly"):
-        assert (out / "calibration" / asm / unit(out, asm) / "ga_best.json").is_file()
-        assert (out / "posterior" / asm / unit(out, asm) / "summary.csv").is_file()
-    assert (out / "posterior" / "table_3_2.md").is_file()
-    assert (out / "figures" / "fig3_11_validation.png").is_file()
-    for asm in ("first", "reassembly"):
-        d = json.loads((out / "discrepancy" / asm / unit(out, asm) / "diagnosis.json").read_text())
-        assert d["effect"] == "fixture_flexibility" and d["metric_after"] < 0.3 * d["metric_before"]
-    for asm in ("first", "reassembly"):  # the design stage: a next test within the shaker limit, its predictions
-        nt = json.loads((out / "design" / asm / unit(out, asm) / "next_test.json").read_text())
-        assert {"level_g", "direction", "sweep_rate_hz_per_s"} <= set(nt["recommended"])
-        assert nt["recommended"]["level_g"] <= 100.0 and {"Fs", "KT", "KT/k"} <= set(nt["predicted_width_ratio"])
-        assert (out / "figures" / f"next_test_{asm}_{unit(out, asm)}.png").is_file() and (out / "design" / asm / unit(out, asm) / "next_test.csv").is_file()
-    # the summary opens on the verdict, in its order, before Table 3.2 and the details
-    page = (out / "report" / "summary.html").read_text()
-    order = [page.index(s) for s in ("reproduce the measured envelopes", "fixture_flexibility",
-                                     "What do the data identify", "The next test", "Table 3.2", "Details")]
-    assert order == sorted(order)
+    defaults = yaml.safe_load((REPO / "workflow" / "config" / "config.yaml").read_text())
+    cases = [(p, v) for p, v in _settings(defaults)]
+    cases += [(("modal", "mode_hz"), 95.0), (("modal", "mode_hz"), [18.6, 95.0]), (("modal", "mode_hz"), None)]
+    assert len(cases) > 40  # the walk reached the nested sections
+    for path, value in cases:
+        text = yaml.safe_dump(value, default_flow_style=True).strip().removesuffix("...").strip()
+        for key in reversed(path[1:]):
+            text = f"{{{key}: {text}}}"
+        config = yaml.safe_load((REPO / "workflow" / "config" / "config.yaml").read_text())
+        update_config(config, parse_config([f"{path[0]}={text}"]))
+        assert config_problem(config, SCHEMA) is None, (path, text)
+        got = config
+        for key in path:
+            got = got[key]
+        assert got == value, (path, text, got)
+    msg = config_problem({"modal": {"mode_hz": ["95", "high"]}}, SCHEMA)
+    assert msg is not None and "\n" not in msg and "modal.mode_hz" in msg

@@ -2,7 +2,7 @@
 
 Run:  python tests/benchmarks/accept_backbone.py [--quick]
 
-The jointed 100 Hz beam of `tests/_rigs.py` (a second, linear mode at 230 Hz at the driving
+The jointed 100 Hz beam of `tests/_support/rigs.py` (a second, linear mode at 230 Hz at the driving
 point; a small open-loop shaker with its electrical dynamics) at three drive levels, swept
 at eta 0.5, 5, 50 and 500 (slow sweeps over +-30% of the mode; faster ones over 30-260 Hz,
 the second mode included), up and down, with 2% noise, seeds 1-3, for both references.
@@ -23,8 +23,8 @@ from pathlib import Path
 
 import pandas as pd
 
-sys.path.insert(0, str(Path(__file__).parents[1]))
-import _rigs  # noqa: E402
+sys.path.insert(0, str(Path(__file__).parents[2]))
+from tests._support import rigs as _rigs  # noqa: E402
 
 ETAS = (0.5, 5.0, 50.0, 500.0)
 

@@ -36,8 +36,8 @@ import numpy as np
 import pandas as pd
 import yaml
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from _modal_helpers import modal_table  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+from tests._support.modal_helpers import modal_table  # noqa: E402
 from jointcal.calibrate import CalibrateSettings, read_modal, run_calibration  # noqa: E402
 from jointcal.design import DesignSettings, run_design  # noqa: E402
 from jointcal.design.narrowing import DEPTHS, depth_labels  # noqa: E402

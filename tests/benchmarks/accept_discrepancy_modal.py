@@ -1,7 +1,7 @@
 """Acceptance of the discrepancy stage on force- and voltage-driven campaigns of a jointed beam (issue 30).
 
 Each case: a virtual-lab campaign (`jointcal.synth.generate`: exact-Iwan time simulation of the
-jointed beam of `tests/_rigs.py` on its open-loop shaker, the DAQ chain, 2% noise) of three levels
+jointed beam of `tests/_support/rigs.py` on its open-loop shaker, the DAQ chain, 2% noise) of three levels
 at two sweep rates (eta 0.5 and 2 at the middle level), one hidden effect at a given strength;
 measured (`measure_run`), calibrated (GA on eq. 3.9, the modal model kind), then
 `jointcal.discrepancy.diagnose` with the modal library (time-domain revalidation included).
@@ -48,8 +48,8 @@ from pathlib import Path
 import pandas as pd
 import yaml
 
-sys.path.insert(0, str(Path(__file__).parents[1]))
-from _rigs import JOINTED_BEAM, SECOND_MODE, SMALL_SHAKER, levels_V, truth_curve  # noqa: E402
+sys.path.insert(0, str(Path(__file__).parents[2]))
+from tests._support.rigs import JOINTED_BEAM, SECOND_MODE, SMALL_SHAKER, levels_V, truth_curve  # noqa: E402
 
 from jointcal.calibrate import CalibrateSettings, run_calibration  # noqa: E402
 from jointcal.discrepancy import DiscrepancySettings, diagnose  # noqa: E402

@@ -17,9 +17,9 @@ import numpy as np
 import pandas as pd
 
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE.parent))
+sys.path.insert(0, str(HERE.parents[1]))
 
-from test_input_checks import _adc, _longest_flat_top, _row, _sdof_sweep  # noqa: E402
+from tests.io.test_clipping import _adc, _longest_flat_top, _row, _sdof_sweep  # noqa: E402
 
 from jointcal.io import ingest_campaign, read_manifest, read_run  # noqa: E402
 from jointcal.io._amplitudes import window_amplitudes

@@ -2,7 +2,7 @@
 
 Run:  python tests/benchmarks/accept_modes.py [OUT]
 
-The force-driven virtual structure of `tests/_two_modes.py` (a 100 Hz and a 230 Hz mode, each with its own
+The force-driven virtual structure of `tests/_support/two_modes.py` (a 100 Hz and a 230 Hz mode, each with its own
 Iwan joint, integrated apart by the exact simulator, 1% noise): a wide chirp over both modes and a slow sweep
 over the upper one alone, at three force levels, in one assembly. The workflow runs with the default config
 up to the posterior (`snakemake --cores 2 posterior`). Printed: the modes found and the runs that hold each,
@@ -22,10 +22,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-HERE = Path(__file__).parents[1]
+HERE = Path(__file__).parents[2]
 sys.path.insert(0, str(HERE))
-import _two_modes  # noqa: E402
-from _campaign import workflow_copy  # noqa: E402
+from tests._support import two_modes as _two_modes  # noqa: E402
+from tests._support.workflow import workflow_copy  # noqa: E402
 
 TRUTH_OF = {"m99": "low", "m227": "high", "m226": "high"}
 

@@ -4,7 +4,7 @@ Five campaigns from the virtual lab with truths drawn around Table 3.2 (first as
 raw records -> envelopes -> modal table (the real estimators) -> GA -> emcee. Counts the
 (parameter, campaign) pairs the data constrain whose 90% interval holds the truth; passes
 when at least 15 pairs are constrained and >= 80% are covered. Two campaigns at a time.
-(Moved out of the CI suite for time: ~7 min on 2 cores; test_posterior keeps a coverage
+(Moved out of the CI suite for time: ~7 min on 2 cores; tests/posterior/test_stage.py keeps a coverage
 test on idealised modal tables.)
 
     python tests/benchmarks/accept_pipeline_coverage.py
@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from _modal_helpers import modal_table  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+from tests._support.modal_helpers import modal_table  # noqa: E402
 from jointcal.calibrate import CalibrateSettings, run_calibration  # noqa: E402
 from jointcal.io import write_csv_atomic  # noqa: E402
 from jointcal.measure.scatter import scatter  # noqa: E402

@@ -17,8 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from _modal_tables import TABLE_3_2, modal_tables  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+from tests._support.modal_tables import TABLE_3_2, modal_tables  # noqa: E402
 
 from jointcal.calibrate import CalibrateSettings, calibrate, objective, select_modal  # noqa: E402
 from jointcal.models import G, IwanParams, MinistackModel, simulate  # noqa: E402

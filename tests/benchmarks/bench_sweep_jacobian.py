@@ -2,7 +2,7 @@
 
 Run:  python tests/benchmarks/bench_sweep_jacobian.py [--blas-threads N] [--repeats K]
 
-The force- and voltage-driven jointed-beam rigs of `accept_backbone.py --quick` (`tests/_rigs.py`: three
+The force- and voltage-driven jointed-beam rigs of `accept_backbone.py --quick` (`tests/_support/rigs.py`: three
 levels, up sweeps, seed 1, 2% noise) at eta 0.5 and 5. Each run is read by the modal stage
 (`jointcal.measure.modal.measure_run`) twice in turn, with the sweep fit's Jacobian by forward
 differences (`jacobian='2-point'`, the baseline: the scheme before) and by forward sensitivities
@@ -36,8 +36,8 @@ from jointcal.io import read_manifest, read_run  # noqa: E402
 from jointcal.measure.modal import measure_run  # noqa: E402
 from jointcal.measure.sweepfit import fit_swept_mode  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).parents[1]))
-import _rigs  # noqa: E402
+sys.path.insert(0, str(Path(__file__).parents[2]))
+from tests._support import rigs as _rigs  # noqa: E402
 
 SCHEMES = ("2-point", "sensitivity")
 

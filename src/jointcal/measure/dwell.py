@@ -35,7 +35,7 @@ The read-out, in the order data flows:
    straddle it (then the point nearest to it is given).
 
 Checked against a linear mode's closed-form FRF and the exact Iwan simulator's steady states held
-against first-harmonic balance at the amplitude reached (tests/test_dwell.py).
+against first-harmonic balance at the amplitude reached (tests/measure/test_dwell.py).
 """
 from __future__ import annotations
 

@@ -48,10 +48,10 @@ The estimator (``ringdown_backbone``), in the order data flows:
    window is flagged ``noise_floor``. A window whose fit residual exceeds `MISFIT_MAX` of its
    amplitude (a beating with a close mode, a clipped start) is flagged ``misfit`` and kept, marked.
 
-Checked against closed forms (tests/test_ringdown.py): a linear mode's decay at 5800x over the noise
+Checked against closed forms (tests/measure/test_ringdown.py): a linear mode's decay at 5800x over the noise
 gives its f within 8e-5 and zeta within 1.3% over three decades; the exact Iwan simulator's 100 Hz
 ring-down the first-harmonic balance backbone within 0.017% and 1.9% over 3.1 decades. The virtual
-Ministack at 0.1% noise (tests/test_synth_steady.py; 2.3 kHz, zeta 1.5% falling to 0.4%, the
+Ministack at 0.1% noise (tests/synth/test_steady.py; 2.3 kHz, zeta 1.5% falling to 0.4%, the
 amplitude 10% down each period at the start) reads 1.66-2.12 decades per ring-down within 0.062% in
 f and 2.9% in zeta (36 decays, six seeds), where 6-period windows from 3 periods after the cut had
 read 0.69-0.80 decades: the noise floor's rule stopped them once a fixed window's decay rate was

@@ -90,7 +90,7 @@ def integrated_time(x: NDArray[np.float64], c: float = 5.0) -> NDArray[np.float6
     walkers; tau = 2 sum_{t <= M} rho(t) - 1 with Sokal's window, the smallest M >= c tau(M).
     Here the walkers' series of a quantity go through one real FFT of a fast length (emcee: a
     complex FFT of twice the next power of two per series); the result agrees with emcee's to
-    rounding (tests/test_posterior.py).
+    rounding (tests/posterior/test_sampler.py).
     """
     x = np.asarray(x, dtype=float)
     n_t, _, n_d = x.shape

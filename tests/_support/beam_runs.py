@@ -1,0 +1,26 @@
+"""Test helpers (not jointcal code): the jointed beam as one driven mode, and a chirp of
+its reference (a force or a voltage) with its manifest row and drive gain."""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from jointcal.models import G, IwanParams, MinistackModel
+
+# the jointed beam of tests/_support/rigs.py
+BEAM = MinistackModel(m=1.0 / G, k=818.0, zeta_v=0.008, iwan=IwanParams(4.0, 204.0, -0.5, 0.1))
+FS, F0, F1, RATE = 2048.0, 50.0, 150.0, 4.0  # the chirp starts and stops outside the fitted band (0.6-1.4 f_res)
+GAINS = {"force": (complex(G), 0j, 2 * np.pi * 100.0),  # 1/m at the driving point, real, no slope
+         "voltage": (complex(300.0, -150.0), complex(0.9, 0.6), 2 * np.pi * 100.0)}  # an amplifier's, sloped
+
+
+def _run(ref: str, level: float) -> tuple[pd.DataFrame, dict]:
+    """A linear up-chirp of the reference at `level` (lbf or V) and its manifest row with the drive gain."""
+    t = np.arange(0.0, (F1 - F0) / RATE + 2.0, 1 / FS)
+    r = level * np.sin(2 * np.pi * (F0 * t + 0.5 * RATE * t**2)) * np.minimum(1.0, t / 0.05)
+    r[t > (F1 - F0) / RATE] = 0.0
+    col, lev = ("force_lbf", "level_lbf") if ref == "force" else ("drive_V", "level_V")
+    rec = pd.DataFrame({"time_s": t, col: r, "response_accel_g": np.zeros_like(t)})
+    row = {"run_id": "r1", "assembly": "beam", lev: level, "direction": "up", "f_start_hz": F0, "f_stop_hz": F1,
+           "sweep_rate_hz_per_s": RATE, "sample_rate_hz": FS, "sequence": 1, "drive_gain": GAINS[ref]}
+    return rec, row
