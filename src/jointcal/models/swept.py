@@ -38,11 +38,10 @@ actual phase, and so is the model's (`swept_transmissibility`). The drive betwee
 frames' |A| and psi interpolated linearly (the window-averaged envelope, not the fine one: below).
 On the virtual open-loop force rig (`tests/models/test_swept_drive.py`, frames of `run_envelope`)
 against the time simulation of the same model, E over 0.05 dB / 0.3 deg (eta = r / (f zeta)^2):
-drive magnitude only, E 0.9 / 4.6-4.8 / 25-41 at eta 0.5 / 2 / 10; the complex drive, E 0.13 /
-0.9 / 5.4-6.2 (the run's first and last frames, the drive's start and stop ramps ringing the
-mode, make 0.1 / 0.8 / 0 of these: without them 0.01 / 0.08 / 5.4-6.1). What is left at eta 10
-is the window: the frames are the Hann average of a force that rings within a window, and a
-fine drive reconstructed from the record itself (not available to the fits) brings it to 2.1.
+the drive's magnitude only, E 0.6 / 4.3-4.4 / 22-34 at eta 0.5 / 2 / 10; the complex drive,
+0.01 / 0.07-0.09 / 4.6-6.6 (0.003 dB and 0.03 deg rms at eta 2). What is left at eta 10 is the
+window: the frames are the Hann average of a force that rings within one window, and a fine
+drive taken from the record itself (not available to the fits) brings it to about 2.
 
 Two evaluations:
 
