@@ -7,7 +7,9 @@ each frame's magnitude (dB) and phase (deg), the same bins as the validation err
 (`jointcal.validate.error`); and the run's drive as the envelopes measured it (every such
 frame's time, drive frequency and base amplitude, and the envelopes' window length,
 `jointcal.measure.envelopes.window_length`), which the swept envelope model follows
-(`jointcal.models.swept`).
+(`jointcal.models.swept`). A force or voltage drive is the equivalent base's complex envelope:
+its magnitude and its phase against the sweep (`SweepDrive.phase_rad`), over every frame from
+the run's first to its last (the open-loop force's dip at resonance included).
 """
 from __future__ import annotations
 
@@ -144,8 +146,15 @@ def run_envelope(env: pd.DataFrame, row: Mapping, sigma_db: NDArray, sigma_deg: 
     b = np.clip(np.digitize(x, BINS[1:-1]), 0, len(BINS) - 2)
     L = _window_s(row, zeta_min)
     ok_t = np.flatnonzero(ok)
+    if eq is not None:  # a force or voltage: every frame between the run's first and last is its drive, the dip
+        # at resonance too (there the envelopes may call the drive off: it is small, not absent)
+        span = np.zeros(f.size, bool)
+        span[ok_t[0]:ok_t[-1] + 1] = True
+        ok_t = np.flatnonzero(span & ~env["bad"].to_numpy(bool) & (np.abs(ref) > 0))
     keep = ok_t[np.r_[True, np.diff(t[ok_t]) > 0]]
-    drive = (SweepDrive(t[keep], f[keep], np.abs(ref[keep]), L) if L is not None and keep.size >= 4 else None)
+    phase = None if eq is None else np.unwrap(np.angle(ref[keep]))  # a force or voltage turns in phase
+    drive = (SweepDrive(t[keep], f[keep], np.abs(ref[keep]), L, phase) if L is not None and keep.size >= 4
+             else None)
     col = level_column(row)
     return RunEnvelope(f_hz=f[idx], base_g=np.abs(ref[idx]), T=transmissibility(env)[idx], sigma_db=sigma_db[b],
                        sigma_deg=sigma_deg[b], rate=rate, row=dict(row), t_s=t[idx], drive=drive,

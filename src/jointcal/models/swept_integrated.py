@@ -4,7 +4,9 @@
 RK4 (`_envelope_kernel.slow_flow`) through the resonance, from the quasi-steady state at
 x = -`SPAN` (x = (f / f_res - 1) / zeta, in sweep order) to x = max(`SPAN`, 1.2 eta), and
 averages it over each frame's Hann window as the envelopes are (T = <R> / <A>); other
-frames take `quasi_steady`.
+frames take `quasi_steady`. A drive with a phase (`SweepDrive.phase_rad`) is integrated as its
+complex envelope A = |A| e^{i psi}: the forcing F A - i F' A' - (i/2) alpha F'' A with
+A' = A (dlog|A|/dt + i dpsi/dt), the start state turned by e^{i psi}, and <A> complex.
 """
 from __future__ import annotations
 
@@ -89,6 +91,10 @@ def _integrated(model: MinistackModel, drive: SweepDrive, t_a: float, t_b: float
     w = 2 * np.pi * f
     alpha = 2 * np.pi * r
     A = b * G
+    z0 = complex(Z[0, -1])
+    if drive.phase_rad is not None:  # the complex drive |A| e^{i psi}; the state starts turned with it
+        A = A * np.exp(1j * drive.phase_at(th))
+        z0 = z0 * np.exp(1j * drive.phase_rad[ka])
     mu, mu1, mu2, F, F1, F2 = (v[0] for v in _derivs(model, w, (1, w.size)))
     p0 = np.ascontiguousarray(-mu + 0.5j * alpha * mu2)
     g0 = np.ascontiguousarray(F * A - 1j * F1 * A * dl - 0.5j * alpha * F2 * A)
@@ -96,7 +102,7 @@ def _integrated(model: MinistackModel, drive: SweepDrive, t_a: float, t_b: float
     *scalars, codes, coefs = joint_terms(model, (1, 1))
     joint = (*(float(v[0]) for v in scalars), codes, np.ascontiguousarray(coefs[0]))
     force = np.empty(n, complex)
-    _k.slow_flow(complex(Z[0, -1]), h, w, alpha, p0, g0, m1, *joint, GAUSS_NODES, GAUSS_WEIGHTS, force)
+    _k.slow_flow(z0, h, w, alpha, p0, g0, m1, *joint, GAUSS_NODES, GAUSS_WEIGHTS, force)
     m = float(batch_field(model.m, (1, 1))[0])
     tn, Rn, An = th[::2], -force / m, A[::2]
     L = drive.window_s
