@@ -349,14 +349,14 @@ def _other_words(m: pd.DataFrame) -> list[str]:
         words.append(f"Along {len(d)} free decay{'s' if len(d) > 1 else ''} (read at the measured windows, from the "
                      f"measured amplitude at the cut-off, {d['q_first_meas_in'].min():.3g} to "
                      f"{d['q_first_meas_in'].max():.3g} in, over {d['decades'].min():.2f} to {d['decades'].max():.2f} "
-                     f"decades) the model's frequency is {_pct(fm)} {'high' if fm > 0 else 'low'} and its damping "
+                     f"decades) the model's frequency is {abs(fm) * 100:.3f}% {'high' if fm > 0 else 'low'} and its damping "
                      f"{_pct(zm)} {'above' if zm > 0 else 'below'} the measured at the same amplitude (medians of "
                      f"the runs' mean errors); its decay envelope ends {abs(env):.2f} dB "
                      f"{'above' if env > 0 else 'below'} the measured (median).")
         ref = d[d.get("decay_input", pd.Series("", index=d.index)) == "reference"]
         if len(ref):
             c = ref["drive_scale"]
-            spread = "" if len(ref) == 1 else f"; range {c.min():.3g} to {c.max():.3g}"
+            spread = "" if c.min() == c.max() else f"; range {c.min():.3g} to {c.max():.3g}"
             words.append(f"To ring down from the measured amplitude the model was driven at {c.median():.3g} times "
                          f"the recorded drive (median{spread}).")
     return words

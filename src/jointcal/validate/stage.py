@@ -1,10 +1,12 @@
 """The validation stage on files: one (assembly, mode)'s runs simulated with the calibrated model, compared, written.
 
-Outputs (all written atomically): ``metrics.csv`` (one row per run, `validate_runs`),
+Outputs (all written atomically): ``metrics.csv`` (one row per run, `validate_runs`; with dwells or ring-downs
+a ``test`` column, and their parts of E),
 ``summary.json`` (E and its parts, the misfit in words, the median read-out errors, the model,
 the settings, the wall time) and the ``envelopes/`` folder (each run's measured and simulated
-frames, ``<run_id>.csv``; a force- or voltage-driven run's response envelope in time,
-``traces/<run_id>.csv``).
+frames, ``<run_id>.csv``, or a dwell's point and a decay's windows, `jointcal.validate.testkinds`; a force- or
+voltage-driven swept run's response envelope in time, ``traces/<run_id>.csv``). With dwells or ring-downs the
+summary adds E_f, E_zeta and ``per_test`` (E and its parts per test kind).
 
 The GA optimum gives E and the metrics; posterior draws give the predictive band only. A force or
 voltage drives the calibrated mode through the campaign's modal constant
