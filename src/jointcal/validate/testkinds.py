@@ -26,6 +26,7 @@ from ..measure.testkinds import read_test_run
 from ..models import MinistackModel
 from .decay import compare_decay, decay_from_cut, decay_input
 from .drive import model_input, reference_column, response_to
+from .runs import run_head
 from .steady import compare_dwell
 
 __all__ = ["validate_test_run"]
@@ -66,8 +67,6 @@ def validate_test_run(model: MinistackModel, record: pd.DataFrame, row: Mapping,
         `compare_dwell`'s and `compare_decay`'s metrics, drive_scale (the decay's input scale c),
         decay_input ('reference' or 'held sine'), note (why a part was not compared), sim_s, compare_s.
     """
-    from .runs import run_head
-
     t0 = time.perf_counter()
     row = dict(row)
     head = {**run_head(row), "test": kind_of(row)}
