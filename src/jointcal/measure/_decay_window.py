@@ -58,7 +58,8 @@ def _gauss_newton(p: NDArray, t: NDArray, x: NDArray, free: int, iters: int = 40
     return p, a, b, m, dm, B
 
 
-def fit_window(t: NDArray, x: NDArray, w0: float, sigma0: float = 0.0) -> tuple[float, float, complex, float, float]:
+def fit_window(t: NDArray, x: NDArray, w0: float,
+               sigma0: float = 0.0) -> tuple[float, float, complex, float, float, float]:
     """Fit one window of a decay.
 
     Parameters
@@ -85,13 +86,16 @@ def fit_window(t: NDArray, x: NDArray, w0: float, sigma0: float = 0.0) -> tuple[
     se_sigma : float
         Standard error of sigma per unit white-noise rms: sqrt of (J^T J)^-1's sigma entry over all six
         parameters (multiply by the noise's rms).
+    se_w : float
+        The same for w, rad/s per unit white-noise rms.
     """
     p, *_ = _gauss_newton(np.array([w0, sigma0, 0.0, 0.0]), t, x, free=2)
     p, a, b, m, dm, B = _gauss_newton(p, t, x, free=4)
     J = np.column_stack([t * dm, -t * m, 0.5 * t * t * dm, -0.5 * t * t * m, B])
     try:
-        se = float(np.sqrt(np.linalg.inv(J.T @ J)[1, 1]))
+        cov = np.linalg.inv(J.T @ J)
+        se, se_w = float(np.sqrt(cov[1, 1])), float(np.sqrt(cov[0, 0]))
     except np.linalg.LinAlgError:
-        se = np.inf
+        se = se_w = np.inf
     misfit = float(np.sqrt(np.mean((x - m) ** 2)) / max(np.hypot(a, b) / np.sqrt(2), 1e-300))
-    return float(p[0]), float(p[1]), complex(a, b), misfit, se
+    return float(p[0]), float(p[1]), complex(a, b), misfit, se, se_w

@@ -67,7 +67,7 @@ from scipy import signal
 from ..units import G
 from ._decay_window import fit_window
 
-__all__ = ["decay_start", "ringdown_backbone", "DRIVE_OFF", "HOLD", "BAND", "ZETA_SE_MAX", "MISFIT_MAX", "SETTLE",
+__all__ = ["decay_start", "ringdown_backbone", "ringdown_at", "COLUMNS", "DRIVE_OFF", "HOLD", "BAND", "ZETA_SE_MAX", "MISFIT_MAX", "SETTLE",
            "TAIL", "MIN_CYCLES", "GROW", "SPAN_MAX", "EXTEND", "SETTLE_MIXED"]
 
 DRIVE_OFF = 0.02  # a drive below this share of its largest value is off
@@ -139,12 +139,59 @@ def _band_passed_decay(x: NDArray, y: NDArray, i0: int, sos, n: int, fs: float, 
     t_pad = (np.arange(-pad, 0) - (n - 1) / 2) / fs
     src = x
     for k in range(2):
-        w, sig, c, misfit, _ = fit_window(_centred(n, fs), src[i0:i0 + n], 2 * np.pi * f_hz)
+        w, sig, c, misfit, _, _ = fit_window(_centred(n, fs), src[i0:i0 + n], 2 * np.pi * f_hz)
         if k == 0 and misfit > MISFIT_MAX:
             return None
         cont = np.exp(-sig * t_pad) * (c.real * np.cos(w * t_pad) + c.imag * np.sin(w * t_pad))
         src = np.concatenate([y[:i0], signal.sosfiltfilt(sos, np.concatenate([cont, x[i0:]]))[pad:]])
     return src
+
+
+COLUMNS = ["t_s", "window_s", "q_in", "f_hz", "zeta", "zeta_se", "f_se_hz", "misfit", "flags"]
+
+
+def _prepared(response_g: NDArray, fs: float, f_hz: float, start: int | None, drive: NDArray | None,
+              min_cycles: float) -> tuple[NDArray, int, int, float, float]:
+    """Steps 1-2 and the noise of step 5: (y, i0, n, settle, noise).
+
+    y is the record band-passed (its decay apart, `_band_passed_decay`, where it is one mode), i0 the
+    decay's first sample, n the shortest window (samples), settle the periods left out after i0, noise
+    the band-passed record's rms over its last `TAIL` (its unit)."""
+    x = np.nan_to_num(np.asarray(response_g, float))
+    if not (np.isfinite(f_hz) and 0 < f_hz * (1 + BAND) < fs / 2):
+        raise ValueError(f"the mode's frequency {f_hz!r} Hz must lie below the record's Nyquist frequency {fs / 2:g} Hz.")
+    sos = signal.butter(4, [f_hz * (1 - BAND), f_hz * (1 + BAND)], btype="bandpass", fs=fs, output="sos")
+    x = x - np.median(x)
+    y = signal.sosfiltfilt(sos, x)
+    i0 = decay_start(fs, y, drive) if start is None else int(start)
+    n = max(16, int(round(min_cycles * fs / f_hz)))
+    noise = float(np.sqrt(np.mean(y[-max(n, int(TAIL * y.size)):] ** 2)))  # where the decay has died out
+    apart = _band_passed_decay(x, y, i0, sos, n, fs, f_hz) if i0 + n <= y.size else None
+    settle = SETTLE
+    if apart is None:  # other modes from the start: the whole record band-passed, read after their onsets' ring
+        settle, n = SETTLE_MIXED, 2 * n
+    else:
+        y = apart
+    return y, i0, n, settle, noise
+
+
+def _read_window(y: NDArray, lo: int, n: int, fs: float, f_hz: float, w0: float, sig0: float,
+                 noise: float) -> tuple[dict, float, float, float]:
+    """Steps 3-5 on one window y[lo:lo + n]: its row (`ringdown_backbone`'s columns), w, sigma and sigma's
+    standard error (rad/s, 1/s, 1/s)."""
+    per_sample = np.sqrt(fs / (4 * BAND * f_hz))  # one independent noise sample in fs / 2B
+    w, sig, c, res, se_sig, se_w = fit_window(_centred(n, fs), y[lo:lo + n], w0, sig0)
+    n_eff = n / per_sample**2
+    window_noise = noise  # the tail; the residual too where it holds enough independent samples
+    if n_eff > 2 * PARAMS:
+        window_noise = min(noise, res * abs(c) / np.sqrt(2) / np.sqrt(1 - PARAMS / n_eff))
+    se_sig *= window_noise * per_sample
+    se_w *= window_noise * per_sample
+    wn = float(np.hypot(w, sig))
+    row = dict(t_s=(lo + (n - 1) / 2) / fs, window_s=n / fs, q_in=abs(c) * G / wn**2, f_hz=wn / (2 * np.pi),
+               zeta=sig / wn, zeta_se=se_sig / wn, f_se_hz=se_w / (2 * np.pi), misfit=res,
+               flags="misfit" if res > MISFIT_MAX else "")
+    return row, w, sig, se_sig
 
 
 def ringdown_backbone(response_g: NDArray, fs: float, f_hz: float, *, start: int | None = None,
@@ -171,34 +218,14 @@ def ringdown_backbone(response_g: NDArray, fs: float, f_hz: float, *, start: int
     DataFrame
         One row per window, in time order: ``t_s`` (window centre, s from the record's start),
         ``window_s`` (its length, s), ``q_in`` (displacement amplitude, in), ``f_hz`` (undamped natural
-        frequency, Hz), ``zeta``, ``zeta_se`` (its standard error from the noise), ``misfit`` (relative rms
-        residual), ``flags`` (``noise_floor`` on the last row read, ``misfit``).
+        frequency, Hz), ``zeta``, ``zeta_se`` and ``f_se_hz`` (their standard errors from the noise; Hz),
+        ``misfit`` (relative rms residual), ``flags`` (``noise_floor`` on the last row read, ``misfit``).
     """
-    x = np.nan_to_num(np.asarray(response_g, float))
-    if not (np.isfinite(f_hz) and 0 < f_hz * (1 + BAND) < fs / 2):
-        raise ValueError(f"the mode's frequency {f_hz!r} Hz must lie below the record's Nyquist frequency {fs / 2:g} Hz.")
-    sos = signal.butter(4, [f_hz * (1 - BAND), f_hz * (1 + BAND)], btype="bandpass", fs=fs, output="sos")
-    x = x - np.median(x)
-    y = signal.sosfiltfilt(sos, x)
-    i0 = decay_start(fs, y, drive) if start is None else int(start)
-    n = max(16, int(round(min_cycles * fs / f_hz)))
-    noise = float(np.sqrt(np.mean(y[-max(n, int(TAIL * y.size)):] ** 2)))  # where the decay has died out
-    apart = _band_passed_decay(x, y, i0, sos, n, fs, f_hz) if i0 + n <= y.size else None
-    settle = SETTLE
-    if apart is None:  # other modes from the start: the whole record band-passed, read after their onsets' ring
-        settle, n = SETTLE_MIXED, 2 * n
-    else:
-        y = apart
-    per_sample = np.sqrt(fs / (4 * BAND * f_hz))  # one independent noise sample in fs / 2B
+    y, i0, n, settle, noise = _prepared(response_g, fs, f_hz, start, drive, min_cycles)
     w0, sig0, rows = 2 * np.pi * f_hz, 0.0, []
     lo = i0 + int(round(settle * fs / f_hz))
     while lo + n <= y.size:
-        w, sig, c, res, se_sig = fit_window(_centred(n, fs), y[lo:lo + n], w0, sig0)
-        n_eff = n / per_sample**2
-        window_noise = noise  # the tail; the residual too where it holds enough independent samples
-        if n_eff > 2 * PARAMS:
-            window_noise = min(noise, res * abs(c) / np.sqrt(2) / np.sqrt(1 - PARAMS / n_eff))
-        se_sig *= window_noise * per_sample
+        row, w, sig, se_sig = _read_window(y, lo, n, fs, f_hz, w0, sig0, noise)
         good = sig > 0 and 0.5 * w0 < w < 1.5 * w0
         longer = int(n * GROW) + 1
         if good and se_sig > ZETA_SE_MAX * sig and sig * longer / fs <= SPAN_MAX and lo + longer <= y.size:
@@ -210,10 +237,43 @@ def ringdown_backbone(response_g: NDArray, fs: float, f_hz: float, *, start: int
                 continue
             rows[-1]["flags"] = ";".join(filter(None, [rows[-1]["flags"], "noise_floor"]))
             break
-        wn = float(np.hypot(w, sig))
-        rows.append(dict(t_s=(lo + (n - 1) / 2) / fs, window_s=n / fs, q_in=abs(c) * G / wn**2,
-                         f_hz=wn / (2 * np.pi), zeta=sig / wn, zeta_se=se_sig / wn, misfit=res,
-                         flags="misfit" if res > MISFIT_MAX else ""))
+        rows.append(row)
         w0, sig0 = w, sig
         lo += max(1, n // 2)
-    return pd.DataFrame(rows, columns=["t_s", "window_s", "q_in", "f_hz", "zeta", "zeta_se", "misfit", "flags"])
+    return pd.DataFrame(rows, columns=COLUMNS)
+
+
+def ringdown_at(response_g: NDArray, fs: float, f_hz: float, windows: pd.DataFrame, *, start: int | None = None,
+                drive: NDArray | None = None, min_cycles: float = MIN_CYCLES) -> pd.DataFrame:
+    """`ringdown_backbone`'s read-out of a decay at given windows: another record read where one was read.
+
+    The same band-pass, start and window fit (steps 1-5), each window of `windows` (its ``t_s`` centre and
+    ``window_s`` length) fitted as it stands: no growing, no noise-floor stop. A model's decay read at the
+    measured decay's windows carries the same window-length bias, which then cancels in a comparison.
+
+    Parameters
+    ----------
+    response_g, fs, f_hz, start, drive, min_cycles
+        As `ringdown_backbone`.
+    windows : DataFrame
+        ``t_s`` (window centre, s from the record's start) and ``window_s`` (s), e.g. `ringdown_backbone`'s
+        rows of another record of the same length and sample rate.
+
+    Returns
+    -------
+    DataFrame
+        `ringdown_backbone`'s columns, one row per window of `windows` in its order (flags: ``misfit`` only).
+    """
+    y, _, _, _, noise = _prepared(response_g, fs, f_hz, start, drive, min_cycles)
+    w0, sig0, rows = 2 * np.pi * f_hz, 0.0, []
+    for t_c, length in zip(windows["t_s"].to_numpy(float), windows["window_s"].to_numpy(float)):
+        n = int(round(length * fs))
+        lo = int(round(t_c * fs - (n - 1) / 2))
+        if lo < 0 or lo + n > y.size:
+            raise ValueError(f"a window centred at {t_c:g} s, {length:g} s long, lies outside the record "
+                             f"({y.size / fs:g} s); read windows of a record as long as this one.")
+        row, w, sig, _ = _read_window(y, lo, n, fs, f_hz, w0, sig0, noise)
+        rows.append(row)
+        if sig > 0 and 0.5 * w0 < w < 1.5 * w0:
+            w0, sig0 = w, sig
+    return pd.DataFrame(rows, columns=COLUMNS)

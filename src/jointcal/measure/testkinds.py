@@ -30,7 +30,7 @@ from .dwell import dwell_mode, dwell_point
 from .modes import mode_name
 from .ringdown import decay_start, ringdown_backbone
 
-__all__ = ["other_kinds_modal", "backbone_table", "BACKBONE_COLUMNS", "MIN_DECAY_S", "NEAR"]
+__all__ = ["other_kinds_modal", "backbone_table", "read_test_run", "BACKBONE_COLUMNS", "MIN_DECAY_S", "NEAR"]
 
 BACKBONE_COLUMNS = ["run_id", "mode", "test", "q_in", "f_hz", "zeta"]
 MIN_DECAY_S = 1.0  # a dwell's record this long after the cut holds a ring-down to read (as decay_start asks)
@@ -61,8 +61,27 @@ def _decay(resp: np.ndarray, ref: np.ndarray, fs: float) -> int | None:
     return start if (resp.size - start) / fs >= MIN_DECAY_S else None
 
 
-def _read_run(row: dict, record: pd.DataFrame, kind: str, mode_hz) -> dict:
-    """One run's frequency, ring-down windows and dwell point."""
+def read_test_run(row: dict, record: pd.DataFrame, kind: str, mode_hz=None) -> dict:
+    """One dwell or ring-down run read as the modal stage reads it (steps 1-3 of the module docstring).
+
+    Parameters
+    ----------
+    row : dict
+        Its row of runs.csv (``test``, ``sample_rate_hz``, ``dwell_hz`` for a dwell).
+    record : DataFrame
+        Its record (`jointcal.io.read_run`).
+    kind : {'base', 'force', 'voltage'}
+        The excitation.
+    mode_hz : float or list of float, optional
+        The frequencies to read at (``modal.mode_hz``, or the modal stage's own read: its ``mode_peak_hz``).
+
+    Returns
+    -------
+    dict
+        ``row``; ``f_guess`` (Hz), the frequency read at; ``start``, the decay's first sample (None without a
+        decay of `MIN_DECAY_S`); ``windows`` (`ringdown_backbone`'s table, None without a decay); ``point``
+        (`dwell_point`'s dict, None but for a dwell); ``notes``.
+    """
     fs = float(row["sample_rate_hz"])
     resp = np.nan_to_num(record[RESPONSE].to_numpy(float))
     ref = np.nan_to_num(record[REFERENCE[kind]].to_numpy(float))
@@ -75,7 +94,7 @@ def _read_run(row: dict, record: pd.DataFrame, kind: str, mode_hz) -> dict:
         f = _peak_hz(resp, fs)
     if mode_hz is not None:
         f = min((float(v) for v in np.atleast_1d(mode_hz)), key=lambda v: abs(v - f))
-    out = {"row": row, "f_guess": f, "windows": None, "point": None, "notes": []}
+    out = {"row": row, "f_guess": f, "start": start, "windows": None, "point": None, "notes": []}
     if start is not None:
         out["windows"] = ringdown_backbone(resp, fs, f, start=start)
     if row.get("test") == "dwell":
@@ -128,7 +147,7 @@ def other_kinds_modal(rows: list[dict], records: dict, kind: str, swept: dict[st
         `BACKBONE_COLUMNS` rows: each ring-down window (``test`` ``ringdown``) and each dwell's point.
     """
     level = LEVEL[kind]
-    reads = [_read_run(r, records[r["run_id"]], kind, mode_hz) for r in rows if records.get(r["run_id"]) is not None]
+    reads = [read_test_run(r, records[r["run_id"]], kind, mode_hz) for r in rows if records.get(r["run_id"]) is not None]
     _names(reads, swept, level)
     dwells: dict[tuple, list[dict]] = {}
     for r in reads:
@@ -165,7 +184,8 @@ def other_kinds_modal(rows: list[dict], records: dict, kind: str, swept: dict[st
             out.update(f_res_hz=d["f_hz"], zeta_res=d["zeta"], q_in=d["q_in"], f_res_method="dwell",
                        dwell_hz=p["f_hz"], dwell_ratio_re=p["ratio"].real, dwell_ratio_im=p["ratio"].imag,
                        f_dwell_quad_hz=fit["f_hz"], zeta_dwell_quad=fit["zeta"], q_dwell_quad_in=fit["q_in"],
-                       dwell_residual=fit["residual"])
+                       dwell_residual=fit["residual"], dwell_constant_re=fit["A"].real,
+                       dwell_constant_im=fit["A"].imag)
         elif w is not None and len(w):  # a ring-down, or a dwell read only along its ring-down
             flags += r["dwell"]["fit"]["flags"] if r.get("dwell") else []
             top = w.loc[w["q_in"].idxmax()]

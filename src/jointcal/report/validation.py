@@ -36,8 +36,11 @@ def _trace_panel(ax, traces: Mapping[str, pd.DataFrame], runs: pd.DataFrame, uni
 
 
 def _pick(metrics: pd.DataFrame) -> pd.DataFrame:
-    """One run per (level, direction): the first usable one in test order."""
+    """One swept run per (level, direction): the first usable one in test order (dwells and ring-downs have
+    no envelope over frequency)."""
     m = metrics[metrics["n_frames"] > 0]
+    if "test" in m:
+        m = m[m["test"] == "sweep"]
     return m.sort_values("sequence").groupby(["level", "direction"], sort=True).head(1)
 
 

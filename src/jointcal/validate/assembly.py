@@ -17,10 +17,12 @@ import numpy as np
 import pandas as pd
 
 from ..io.contract import LEVEL, excitation_kind
+from ..io._kinds import kind_of
 from ..models import MinistackModel
 from .error import describe_misfit, envelope_error, repeat_scatter
 from .runs import (band_frames, compare_run, draw_transmissibility, full_drive_fraction, measure_pair,
                    reference_column, run_head, time_envelopes)
+from .testkinds import validate_test_run
 from .._config import config_section
 
 __all__ = ["ValidateSettings", "Validation", "validate_runs"]
@@ -87,6 +89,9 @@ class Validation:
 
 def _one_run(model: MinistackModel, record: pd.DataFrame, row: dict, draws: Sequence[MinistackModel],
              s: ValidateSettings, envelopes_kw: dict | None, modal_kw: dict | None):
+    if kind_of(row) != "sweep":  # a dwell or ring-down: its point and decay (no predictive band)
+        frames, metrics = validate_test_run(model, record, row, floor_db=s.floor_db, floor_deg=s.floor_deg)
+        return frames, {**metrics, "draws_s": 0.0, "n_draws": 0}, None
     t0 = time.perf_counter()
     try:
         (env_m, meta_m, props_m), (env_s, _, props_s), sim_record = measure_pair(
@@ -129,14 +134,20 @@ def validate_runs(models: Sequence[MinistackModel] | Callable[[dict], MinistackM
                   executor: Executor | None = None) -> Validation:
     """Simulate, measure and compare every run of one assembly; E and the misfit in words.
 
+    A sweep is compared frame by frame (`compare_run`); a dwell or a ring-down (the row's ``test``) by its
+    steady point and its decay (`jointcal.validate.testkinds.validate_test_run`), and metrics.csv then has a
+    ``test`` column. The scale of the sweeps' frames is their repeat scatter (`repeat_scatter`, over the
+    sweeps alone); a dwell's and a ring-down's are their read-outs' own.
+
     Parameters
     ----------
     models : sequence of MinistackModel (one per run, in `rows` order) or callable row -> MinistackModel
-        The model of each run, driven by that run's measured base record.
+        The model of each run, driven by that run's measured reference record.
     records : sequence of DataFrame
-        The measured records (time_s, base_accel_g, response_accel_g; g).
+        The measured records (time_s, the reference channel, response_accel_g; g).
     rows : sequence of mapping
-        Their manifest rows (run_id, level_g, direction, f_start_hz, f_stop_hz, sample_rate_hz, ...).
+        Their manifest rows (run_id, level_g, direction, f_start_hz, f_stop_hz, sample_rate_hz, test, dwell_hz,
+        ...; ``mode_hz``, the frequency the modal stage read the run at).
     settings : ValidateSettings
     draws : sequence of MinistackModel, or callable row -> sequence
         Posterior-draw models for the predictive band (not used by E); empty for none.
@@ -161,7 +172,11 @@ def validate_runs(models: Sequence[MinistackModel] | Callable[[dict], MinistackM
     frames = {r["run_id"]: fr for r, (fr, _, _) in zip(rows, results)}
     traces = {r["run_id"]: tr for r, (_, _, tr) in zip(rows, results) if tr is not None}
     metrics = pd.DataFrame([mt for _, mt, _ in results])
-    scale = repeat_scatter(frames, metrics, floor_db=settings.floor_db, floor_deg=settings.floor_deg)
+    swept = metrics
+    if "test" in metrics:  # dwells or ring-downs among the runs: every row names its kind; the scale is the sweeps'
+        metrics.insert(list(metrics.columns).index("n_frames"), "test", metrics.pop("test").fillna("sweep"))
+        swept = metrics[metrics["test"] == "sweep"]
+    scale = repeat_scatter(frames, swept, floor_db=settings.floor_db, floor_deg=settings.floor_deg)
     error = envelope_error(frames, metrics, scale)
     return Validation(metrics=metrics, frames=frames, scale=scale, error=error, traces=traces,
                       words=describe_misfit(metrics, error, level_unit=LEVEL[excitation_kind(

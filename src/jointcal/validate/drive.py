@@ -20,7 +20,7 @@ from ..models import MinistackModel, fractional_delay, simulate
 from ..units import G
 
 __all__ = ["reference_column", "clean_base", "drive_gain", "gain_at", "equivalent_base", "model_input",
-           "simulate_record"]
+           "dwell_gain", "response_to", "simulate_record"]
 
 
 def reference_column(record: pd.DataFrame) -> str:
@@ -48,14 +48,16 @@ def drive_gain(modal: pd.DataFrame) -> tuple[complex, complex, float] | None:
     """The campaign's modal constant, (A_c, A' per rad/s, w_c rad/s): the median over the swept-mode fits.
 
     Each run's A (at its f_res_hz) is moved to the common w_c (the median resonance) along its own
-    slope; the median of the real and imaginary parts of A_c and A'. None without sweep fits.
+    slope; the median of the real and imaginary parts of A_c and A'. Without sweep fits, the dwells'
+    (`jointcal.measure.dwell.dwell_mode`'s A of each level, in modal_properties.csv's ``dwell_constant_re``
+    and ``_im``): their median, unsloped, at the median of the dwell rows' f_res_hz. None without either.
     """
     need = ("modal_constant_re", "modal_constant_im", "modal_slope_re", "modal_slope_im", "f_res_hz")
     if not all(c in modal.columns for c in need):
-        return None
+        return dwell_gain(modal)
     ok = modal[list(need)].apply(pd.to_numeric, errors="coerce").dropna()
     if ok.empty:
-        return None
+        return dwell_gain(modal)
     w = 2 * np.pi * ok["f_res_hz"].to_numpy()
     wc = float(np.median(w))
     a = ok["modal_constant_re"].to_numpy() + 1j * ok["modal_constant_im"].to_numpy()
@@ -63,6 +65,18 @@ def drive_gain(modal: pd.DataFrame) -> tuple[complex, complex, float] | None:
     ac = a + da * (wc - w)
     med = lambda z: complex(np.median(z.real), np.median(z.imag))  # noqa: E731
     return med(ac), med(da), wc
+
+
+def dwell_gain(modal: pd.DataFrame) -> tuple[complex, complex, float] | None:
+    """The dwells' modal constant in `drive_gain`'s form (its slope 0), or None (no level of three dwells)."""
+    need = ("dwell_constant_re", "dwell_constant_im", "f_res_hz")
+    if not all(c in modal.columns for c in need):
+        return None
+    ok = modal[list(need)].apply(pd.to_numeric, errors="coerce").dropna()
+    if ok.empty:
+        return None
+    return (complex(np.median(ok["dwell_constant_re"]), np.median(ok["dwell_constant_im"])), 0j,
+            float(2 * np.pi * np.median(ok["f_res_hz"])))
 
 
 def gain_at(gain: tuple[complex, complex, float], f_hz: NDArray) -> NDArray[np.complex128]:
@@ -101,9 +115,20 @@ def model_input(record: pd.DataFrame, row: Mapping) -> tuple[NDArray[np.float64]
     gain = row.get("drive_gain")
     if gain is None:
         raise ValueError(f"run {row.get('run_id', '?')}: a {col} reference drives the model through the mode's "
-                         "modal constant, and the modal stage found none (no swept-mode fit in the campaign); "
+                         "modal constant, and the modal stage found none (no swept-mode fit and no level of three dwells "
+                         "in the campaign); "
                          "the run cannot be simulated.")
     return -_through_gain(x, float(row["sample_rate_hz"]), gain) / G, col
+
+
+def response_to(model: MinistackModel, a_b: NDArray, fs: float, *, relative: bool) -> NDArray[np.float64]:
+    """The model's response channel (g) to the input a_b (g, shape (N,), sampled at fs Hz): the absolute
+    acceleration for a base drive; with ``relative`` (a fixed base forced by -m a_b: a force or voltage drive)
+    the mass's acceleration relative to the base, read through the same sensor gain and delay."""
+    y = simulate(model, a_b, fs).response_g
+    if relative:
+        y = y - model.sensor_gain * (fractional_delay(a_b, model.sensor_delay_s, fs) if model.sensor_delay_s else a_b)
+    return y
 
 
 def simulate_record(model: MinistackModel, record: pd.DataFrame, row: Mapping) -> pd.DataFrame:
@@ -113,11 +138,7 @@ def simulate_record(model: MinistackModel, record: pd.DataFrame, row: Mapping) -
     so the same frames are left out of both envelopes.
     """
     a_b, col = model_input(record, row)
-    y = simulate(model, a_b, float(row["sample_rate_hz"])).response_g
-    if col != REFERENCE["base"]:  # a fixed base forced by -m a_b: the mass's acceleration is the relative one,
-        # read through the same sensor gain and delay as the simulated channel
-        fs = float(row["sample_rate_hz"])
-        y = y - model.sensor_gain * (fractional_delay(a_b, model.sensor_delay_s, fs) if model.sensor_delay_s else a_b)
+    y = response_to(model, a_b, float(row["sample_rate_hz"]), relative=col != REFERENCE["base"])
     y[~np.isfinite(record[col].to_numpy(dtype=float))] = np.nan
     out = record[["time_s", col]].copy()
     out["response_accel_g"] = y

@@ -156,7 +156,7 @@ def own_noise(frames: Mapping[str, pd.DataFrame], metrics: pd.DataFrame, *, degr
 def envelope_error(frames: Mapping[str, pd.DataFrame], metrics: pd.DataFrame, scale: pd.DataFrame) -> dict:
     """The validation envelope error E of one assembly, and its parts.
 
-    Definition. For every usable run r and every frame j of its band (drive on, neither
+    Definition. For every usable swept run r and every frame j of its band (drive on, neither
     record bad, full drive, f within the band around the measured resonance), let
     dM_rj = 20 log10 |T_sim / T_meas| (dB) and dP_rj = arg(T_sim / T_meas) (deg, wrapped to
     (-180, 180]), with T the transmissibility response/base of the envelopes (the
@@ -174,12 +174,20 @@ def envelope_error(frames: Mapping[str, pd.DataFrame], metrics: pd.DataFrame, sc
     scatter); E grows linearly with a systematic misfit. The same means taken over the
     runs of one level give the per-level values.
 
+    Dwells and ring-downs (metrics' ``test``; `jointcal.validate.testkinds`) bring their own parts: a dwell's
+    steady point the same dM and dP over its own uncertainty (one "frame", in E_mag and E_phase); a decay the
+    relative errors of f and zeta at each measured window's amplitude over the read-out's own standard errors
+    (`jointcal.validate.decay.scales`), whose mean squares over the windows are the run's E_f^2 and E_zeta^2.
+    A run's E^2 is the mean of the parts it has ((E_mag^2 + E_phase^2) / 2 for a sweep), and the assembly's
+    E^2 the mean of its runs' (so a sweep-only campaign's E is the definition above).
+
     Parameters
     ----------
     frames : mapping run_id -> DataFrame
         `compare_run` frames.
     metrics : DataFrame
-        `compare_run` metrics (run_id, level, n_frames, f_res_meas_hz, zeta_meas).
+        `compare_run` metrics (run_id, level, n_frames, f_res_meas_hz, zeta_meas), and for dwells and
+        ring-downs `validate_test_run`'s (test, E_mag, E_phase, E_f, E_zeta).
     scale : DataFrame
         `repeat_scatter`'s table.
 
@@ -187,29 +195,51 @@ def envelope_error(frames: Mapping[str, pd.DataFrame], metrics: pd.DataFrame, sc
     -------
     dict
         E, E_mag, E_phase, n_runs, per_level {level: {E, E_mag, E_phase, n_runs}},
-        scale (the bins' sigma_mag_db, sigma_phase_deg, source).
+        scale (the bins' sigma_mag_db, sigma_phase_deg, source); with dwells or ring-downs also E_f,
+        E_zeta and per_test {test: {E, ..., n_runs}} (a part no run has is None).
     """
     sm = scale["sigma_mag_db"].to_numpy()
     sp = scale["sigma_phase_deg"].to_numpy()
+    tests = metrics["test"] if "test" in metrics else pd.Series("sweep", index=metrics.index)
     per_run = []
-    for r in metrics[metrics["n_frames"] > 0].itertuples(index=False):
-        d = frames[r.run_id]
+    for (_, r), test in zip(metrics.iterrows(), tests):
+        if not r["n_frames"] > 0:
+            continue
+        if test != "sweep":
+            per_run.append((r["level"], test, *(float(r.get(k, np.nan)) ** 2 for k in _PARTS)))
+            continue
+        d = frames[r["run_id"]]
         d = d[d["in_band"]]
-        b = _bin(_offset(d["f_hz"].to_numpy(), r.f_res_meas_hz, r.zeta_meas))
-        per_run.append((r.level, np.mean((d["d_mag_db"].to_numpy() / sm[b]) ** 2),
-                        np.mean((d["d_phase_deg"].to_numpy() / sp[b]) ** 2)))
+        b = _bin(_offset(d["f_hz"].to_numpy(), r["f_res_meas_hz"], r["zeta_meas"]))
+        per_run.append((r["level"], test, np.mean((d["d_mag_db"].to_numpy() / sm[b]) ** 2),
+                        np.mean((d["d_phase_deg"].to_numpy() / sp[b]) ** 2), np.nan, np.nan))
     if not per_run:
         raise ValueError("no usable run to validate: every run is unusable or has no frame in the band.")
-    t = pd.DataFrame(per_run, columns=["level", "m2", "p2"])
-
-    def parts(g: pd.DataFrame) -> dict:
-        em, ep = float(np.sqrt(g["m2"].mean())), float(np.sqrt(g["p2"].mean()))
-        return dict(E=float(np.sqrt((em**2 + ep**2) / 2)), E_mag=em, E_phase=ep, n_runs=int(len(g)))
-
-    out = parts(t)
-    out["per_level"] = {f"{lev:g}": parts(g) for lev, g in t.groupby("level", sort=True)}
+    t = pd.DataFrame(per_run, columns=["level", "test", "m2", "p2", "f2", "z2"])
+    out = _parts(t)
+    out["per_level"] = {f"{lev:g}": _parts(g) for lev, g in t.groupby("level", sort=True)}
+    if set(t["test"]) != {"sweep"}:
+        out["per_test"] = {k: _parts(g) for k, g in t.groupby("test", sort=True)}
+    else:
+        for d in (out, *out["per_level"].values()):
+            d.pop("E_f"), d.pop("E_zeta")
     out["scale"] = scale.to_dict(orient="records")
     return out
+
+
+_PARTS = ("E_mag", "E_phase", "E_f", "E_zeta")
+
+
+def _parts(g: pd.DataFrame) -> dict:
+    """E and its parts over the runs of `g` (columns m2, p2, f2, z2: each run's mean squares, NaN where absent)."""
+    sq = g[["m2", "p2", "f2", "z2"]]
+    part = {k: float(np.sqrt(sq[c].mean())) if sq[c].notna().any() else None for k, c in zip(_PARTS, sq.columns)}
+    have = [k for k, v in part.items() if v is not None]
+    if sq[[c for k, c in zip(_PARTS, sq.columns) if k in have]].notna().all().all():  # every run has every part
+        e = float(np.sqrt(sum(part[k] ** 2 for k in have) / len(have)))
+    else:
+        e = float(np.sqrt(sq.mean(axis=1).mean()))
+    return dict(E=e, **part, n_runs=int(len(g)))
 
 
 def _pct(x: float) -> str:
@@ -243,14 +273,41 @@ def closeness(E: float, source: str = "repeats") -> str:
 
 
 def describe_misfit(metrics: pd.DataFrame, err: Mapping, *, level_unit: str = "g") -> str:
-    """The misfit in plain words: E, peak amplitude, resonance, damping, far below resonance."""
+    """The misfit in plain words: E, peak amplitude, resonance, damping, far below resonance; and where the
+    runs hold dwells or ring-downs (metrics' ``test``), their steady points and decays (`_other_words`)."""
     m = metrics[metrics["n_frames"] > 0]
     if m.empty:
         return "no usable run to compare."
     src = scale_source(err.get("scale"))
+    if "test" in m and (m["test"] != "sweep").any():
+        swept = m[m["test"] == "sweep"]
+        words = [_first_words(m, err, src, swept.empty)]
+        if not swept.empty:
+            words += _sweep_words(swept, level_unit)
+        return " ".join(words + _other_words(m[m["test"] != "sweep"]))
     verdict = closeness(err["E"], src)
     words = [f"validation envelope error E = {err['E']:.2f} (magnitude {err['E_mag']:.2f}, phase "
              f"{err['E_phase']:.2f}; 1 = {scale_words(src)}): {verdict}."]
+    return " ".join(words + _sweep_words(m, level_unit))
+
+
+def _first_words(m: pd.DataFrame, err: Mapping, src: str, no_sweeps: bool) -> str:
+    """E over a campaign with dwells or ring-downs: its parts and what 1 means."""
+    count = ", ".join(f"{n} {k}{'s' if n > 1 else ''}" for k, n in m["test"].value_counts(sort=False).items())
+    parts = [f"{name} {err[key]:.2f}" for key, name in (("E_mag", "magnitude"), ("E_phase", "phase"),
+                                                         ("E_f", "frequency"), ("E_zeta", "damping"))
+             if err.get(key) is not None]
+    unit = ("the read-outs' own uncertainty (a dwell point's, a decay window's), never below the sweeps' floors"
+            if no_sweeps else f"{scale_words(src)} for the sweeps, the read-outs' own uncertainty for the dwells "
+            "and ring-downs")
+    verdict = closeness(err["E"], "own noise" if no_sweeps else src)
+    return (f"validation envelope error E = {err['E']:.2f} over {count} ({', '.join(parts)}; 1 = {unit}): "
+            f"{verdict}.")
+
+
+def _sweep_words(m: pd.DataFrame, level_unit: str) -> list[str]:
+    """The sweeps' sentences after the first: peak, resonance, damping, flanks, far below resonance."""
+    words = []
     pr = float(np.nanmedian(m["peak_ratio"]))
     words.append(f"The model {'under' if pr < 1 else 'over'}-predicts the peak response by {_pct(pr - 1)} "
                  f"(median over {len(m)} runs; range {m['peak_ratio'].min():.3f} to {m['peak_ratio'].max():.3f}).")
@@ -272,4 +329,34 @@ def describe_misfit(metrics: pd.DataFrame, err: Mapping, *, level_unit: str = "g
         lo = float(lo_ok.median())
         words.append(f"Far below resonance (f < 0.7 f_res) the measured response is {_pct(1 / lo - 1)} "
                      f"{'above' if lo < 1 else 'below'} the model's.")
-    return " ".join(words)
+    return words
+
+
+def _other_words(m: pd.DataFrame) -> list[str]:
+    """The dwells' steady points and the decays (ring-downs and dwells' ring-downs) in words."""
+    words = []
+    if "dwell_hz" in m and m["dwell_hz"].notna().any():
+        d = m[m["dwell_hz"].notna()]
+        r = 10 ** (d["dwell_mag_err_db"] / 20)
+        med, ph = float(r.median()), float(d["dwell_phase_err_deg"].median())
+        words.append(f"At the steady state of {len(d)} dwell{'s' if len(d) > 1 else ''} (the model driven by each "
+                     f"dwell's record) the model's response is {_pct(med - 1)} {'above' if med > 1 else 'below'} the "
+                     f"measured (median; range {r.min():.3f} to {r.max():.3f} of it) and its phase "
+                     f"{abs(ph):.2f} deg {'ahead of' if ph > 0 else 'behind'} it (median).")
+    if "n_windows" in m and (m["n_windows"] > 0).any():
+        d = m[m["n_windows"] > 0]
+        fm, zm, env = (float(d[c].median()) for c in ("f_rel_err_mean", "zeta_rel_err_mean", "env_end_db"))
+        words.append(f"Along {len(d)} free decay{'s' if len(d) > 1 else ''} (read at the measured windows, from the "
+                     f"measured amplitude at the cut-off, {d['q_first_meas_in'].min():.3g} to "
+                     f"{d['q_first_meas_in'].max():.3g} in, over {d['decades'].min():.2f} to {d['decades'].max():.2f} "
+                     f"decades) the model's frequency is {abs(fm) * 100:.3f}% {'high' if fm > 0 else 'low'} and its damping "
+                     f"{_pct(zm)} {'above' if zm > 0 else 'below'} the measured at the same amplitude (medians of "
+                     f"the runs' mean errors); its decay envelope ends {abs(env):.2f} dB "
+                     f"{'above' if env > 0 else 'below'} the measured (median).")
+        ref = d[d.get("decay_input", pd.Series("", index=d.index)) == "reference"]
+        if len(ref):
+            c = ref["drive_scale"]
+            spread = "" if c.min() == c.max() else f"; range {c.min():.3g} to {c.max():.3g}"
+            words.append(f"To ring down from the measured amplitude the model was driven at {c.median():.3g} times "
+                         f"the recorded drive (median{spread}).")
+    return words

@@ -1,10 +1,12 @@
 """The validation stage on files: one (assembly, mode)'s runs simulated with the calibrated model, compared, written.
 
-Outputs (all written atomically): ``metrics.csv`` (one row per run, `validate_runs`),
+Outputs (all written atomically): ``metrics.csv`` (one row per run, `validate_runs`; with dwells or ring-downs
+a ``test`` column, and their parts of E),
 ``summary.json`` (E and its parts, the misfit in words, the median read-out errors, the model,
 the settings, the wall time) and the ``envelopes/`` folder (each run's measured and simulated
-frames, ``<run_id>.csv``; a force- or voltage-driven run's response envelope in time,
-``traces/<run_id>.csv``).
+frames, ``<run_id>.csv``, or a dwell's point and a decay's windows, `jointcal.validate.testkinds`; a force- or
+voltage-driven swept run's response envelope in time, ``traces/<run_id>.csv``). With dwells or ring-downs the
+summary adds E_f, E_zeta and ``per_test`` (E and its parts per test kind).
 
 The GA optimum gives E and the metrics; posterior draws give the predictive band only. A force or
 voltage drives the calibrated mode through the campaign's modal constant
@@ -25,22 +27,27 @@ import pandas as pd
 from ..io import excitation_kind, listed_record, read_run, write_csv_atomic, write_json_atomic
 from .assembly import ValidateSettings, validate_runs
 from .models import models_from_samples, run_models
-from .drive import drive_gain
+from .drive import drive_gain, dwell_gain
 
 __all__ = ["run_validation"]
 
 _Path = str | os.PathLike[str]
 
 
-def _drive_words(gain: tuple[complex, complex, float], kind: str) -> str:
+def _drive_words(gain: tuple[complex, complex, float], kind: str, by: str = "the swept-mode fits") -> str:
     """How a force- or voltage-driven model is driven, in words (the modal constant A and its slope)."""
     return (f" How the model is driven: the calibrated mode is driven by its modal force per unit modal mass "
             f"A(w) r(t), the recorded {'force' if kind == 'force' else 'amplifier voltage'} through "
             f"the campaign's modal constant A = {gain[0].real:.4g}{gain[0].imag:+.4g}i "
             f"(in/s^2 per reference unit at {gain[2] / (2 * np.pi):.4g} Hz, sloped "
-            f"{abs(gain[1]) * gain[2] / abs(gain[0]):.3g} of itself per unit w/w_c), the median over the "
-            "swept-mode fits" + (": the shaker's electrical and residual dynamics in one complex gain; its "
+            f"{abs(gain[1]) * gain[2] / abs(gain[0]):.3g} of itself per unit w/w_c), the median over {by}"
+            + (": the shaker's electrical and residual dynamics in one complex gain; its "
                                  "back-EMF damping is in the calibrated mode's." if kind == "voltage" else "."))
+
+
+def _median(m: pd.DataFrame, col: str) -> float | None:
+    """The median of a metrics column over the runs that have it (the sweeps'), None where none has."""
+    return float(np.nanmedian(m[col])) if col in m and m[col].notna().any() else None
 
 
 def run_validation(best_json: _Path, runs_csv: _Path, modal_csv: _Path, chain_npz: _Path, records: Sequence[_Path],
@@ -92,6 +99,7 @@ def run_validation(best_json: _Path, runs_csv: _Path, modal_csv: _Path, chain_np
     recs = [read_run(listed_record(str(r["file"]), list(records)), r) for r in rows]
     kind = excitation_kind(recs[0])
     gain = drive_gain(modal_table) if kind != "base" else None
+    by = "the dwells' fits" if gain is not None and gain == dwell_gain(modal_table) else "the swept-mode fits"
     if gain is not None:  # a force or voltage drives the mode through the campaign's modal constant
         rows = [{**r, "drive_gain": gain} for r in rows]
     models, f_ref = run_models(best, modal["f_res_hz"].to_dict(), [r["run_id"] for r in rows])
@@ -110,12 +118,11 @@ def run_validation(best_json: _Path, runs_csv: _Path, modal_csv: _Path, chain_np
         write_csv_atomic(tr, out / "traces" / f"{rid}.csv")
     m = v.metrics
     write_csv_atomic(m, metrics_csv)
-    words = v.words + (_drive_words(gain, kind) if gain is not None else "")
+    words = v.words + (_drive_words(gain, kind, by) if gain is not None else "")
     summary = {**{k: v.error[k] for k in ("E", "E_mag", "E_phase", "n_runs", "per_level", "scale")},
+               **{k: v.error[k] for k in ("E_f", "E_zeta", "per_test") if k in v.error},  # dwells, ring-downs
                "words": words, "assembly": assembly, "n_draws": len(draws),
-               "median_peak_ratio": float(np.nanmedian(m["peak_ratio"])) if "peak_ratio" in m else None,
-               "median_f_res_rel_err": float(np.nanmedian(m["f_res_rel_err"])) if "f_res_rel_err" in m else None,
-               "median_zeta_rel_err": float(np.nanmedian(m["zeta_rel_err"])) if "zeta_rel_err" in m else None,
+               **{f"median_{c}": _median(m, c) for c in ("peak_ratio", "f_res_rel_err", "zeta_rel_err")},
                "model": {k: best[k] for k in ("Fs", "KT", "chi", "beta", "k", "zeta_v", "m", "viscous")},
                "settings": dict(config), "wall_s": time.perf_counter() - t0}
     write_json_atomic(summary, summary_json)
