@@ -14,6 +14,8 @@ or settings (`ValueError`, of which `jointcal.io.CampaignError` and
 `jointcal.calibrate.CalibrationInputError` are kinds) into its one sentence, after the
 warnings, in the log and on stderr, and a non-zero exit without a traceback. `Job.pool` and
 `Job.map` spread work over ``snakemake.threads`` processes, or run it in this one.
+`console_job` is the same frame for the command line (``jointcal <stage>``): its log is stdout, its
+warnings go to stderr, and the command turns the errors into its exit status (`jointcal.cli`).
 Imports nothing of the package, so a stage's code hash (`jointcal._workflow.stage_hash`) gains
 only this file.
 """
@@ -26,9 +28,10 @@ from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import Executor, ProcessPoolExecutor
 from contextlib import contextmanager
 from pathlib import Path
+from types import SimpleNamespace
 from typing import IO, Any
 
-__all__ = ["Job", "stage_job"]
+__all__ = ["Job", "console_job", "stage_job"]
 
 
 class Job:
@@ -42,10 +45,11 @@ class Job:
         Processes the job may use (``snakemake.threads``, at least 1).
     """
 
-    def __init__(self, smk: Any, log_file: IO[str]) -> None:
+    def __init__(self, smk: Any, log_file: IO[str], *, warn_in_log: bool = True) -> None:
         self.smk = smk
         self.threads = max(1, int(getattr(smk, "threads", 1) or 1))
         self._file = log_file
+        self._warn_in_log = warn_in_log
         self._t0 = time.perf_counter()
 
     @property
@@ -58,8 +62,9 @@ class Job:
         self._file.write(f"jointcal: {line}\n")
 
     def warn(self, line: str) -> None:
-        """Write ``jointcal: warning: <line>`` to the log and to stderr."""
-        self.log(f"warning: {line}")
+        """Write ``jointcal: warning: <line>`` to the log (unless it is the console's stdout) and to stderr."""
+        if self._warn_in_log:
+            self.log(f"warning: {line}")
         print(f"jointcal: warning: {line}", file=sys.stderr)
 
     def workers(self, n_tasks: int | None = None) -> int:
@@ -109,3 +114,19 @@ def stage_job(smk: Any, *, errors: tuple[type[BaseException], ...] = (ValueError
         except errors as exc:
             job.log(str(exc))
             sys.exit(f"jointcal: {exc}")
+
+
+@contextmanager
+def console_job(threads: int = 1) -> Iterator[Job]:
+    """A `Job` for the command line: `Job.log` prints to stdout, `Job.warn` (every warning raised inside,
+    as it is raised) to stderr alone; errors pass through to the caller (`jointcal.cli.main`).
+
+    Parameters
+    ----------
+    threads : int, optional
+        Processes `Job.pool` and `Job.map` may use.
+    """
+    with warnings.catch_warnings():
+        job = Job(SimpleNamespace(threads=threads), sys.stdout, warn_in_log=False)
+        warnings.showwarning = lambda message, *_, **__: job.warn(str(message))
+        yield job

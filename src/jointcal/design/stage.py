@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import json
 import os
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -25,12 +26,14 @@ import pandas as pd
 from ..calibrate.data import read_modal, read_table
 from ..calibrate.settings import CalibrateSettings
 from ..io import write_bytes_atomic, write_csv_atomic, write_json_atomic
+from ..posterior.settings import PosteriorSettings
+from ..report.design import design_figure
 from .candidates import candidates
 from .evaluate import REPORTED, evaluate
 from .recommend import next_test_markdown, rank, recommendation
 from .settings import DesignSettings
 
-__all__ = ["OUTPUTS", "targets_of", "words_now", "run_design"]
+__all__ = ["OUTPUTS", "targets_of", "words_now", "run_design", "run_design_unit"]
 
 OUTPUTS = ("next_test.json", "next_test.csv", "next_test.md")
 
@@ -140,3 +143,42 @@ def run_design(runs_csv: str | os.PathLike[str], modal_csv: str | os.PathLike[st
     write_csv_atomic(ranked, out / "next_test.csv")
     write_bytes_atomic(md.encode(), out / "next_test.md")
     return rec, ranked
+
+
+def run_design_unit(runs_csv: str | os.PathLike[str], modal_csv: str | os.PathLike[str],
+                    scatter_csv: str | os.PathLike[str], ga_best_json: str | os.PathLike[str],
+                    chain_npz: str | os.PathLike[str], identified_csv: str | os.PathLike[str], assembly: str,
+                    out_dir: str | os.PathLike[str], *, figure_png: str | os.PathLike[str],
+                    design: Mapping[str, Any], calibrate: Mapping[str, Any], posterior: Mapping[str, Any],
+                    modal: Mapping[str, Any]) -> str:
+    """`run_design` from the config's sections, and the next test's figure (`jointcal.report.design`).
+
+    Parameters
+    ----------
+    runs_csv, modal_csv, scatter_csv, ga_best_json, chain_npz, identified_csv : path-like
+        The stages' outputs (see the module notes).
+    assembly : str
+    out_dir : path-like
+        Folder of `OUTPUTS`.
+    figure_png : path-like
+        Where the figure goes.
+    design, calibrate, posterior, modal : mapping
+        The config's sections (``modal.eta_max``, ``posterior.rel_std_floor``).
+
+    Returns
+    -------
+    str
+        The line for the log: the recommended test and its predicted width ratios, or why none is.
+    """
+    cal = CalibrateSettings.from_config(calibrate)
+    post = PosteriorSettings.from_config(posterior)
+    rec, ranked = run_design(runs_csv, modal_csv, scatter_csv, ga_best_json, chain_npz, identified_csv, assembly,
+                             out_dir, cal, DesignSettings.from_config(design),
+                             eta_max=float(modal.get("eta_max", 0.5)), floors=dict(post.rel_std_floor))
+    data = read_modal(modal_csv, assembly, damping=cal.resolved(json.loads(Path(ga_best_json).read_text())).damping)
+    measured = pd.DataFrame({"level": data.level, "f_hz": data.f, "zeta": data.zeta, "q_in": data.q})
+    write_bytes_atomic(design_figure(rec, ranked, measured, pd.read_csv(identified_csv)), figure_png)
+    r = rec["recommended"]
+    return (f"recommended {r['level_g']:g} g {r['direction']} at {r['sweep_rate_hz_per_s']:g} Hz/s; predicted width "
+            "ratios " + ", ".join(f"{k} {v:.3g}" for k, v in rec["predicted_width_ratio"].items())
+            if r else f"no level recommended: {rec['reason']}")

@@ -6,7 +6,8 @@ Outputs (all written atomically): ``modal_properties.csv`` (one row per run and 
 ``backbone.csv`` (every run's amplitude-dependent points from every test kind,
 `jointcal.measure.testkinds.backbone_table`) and ``frf/<run_id>.csv`` (each run's whole-record FRF,
 `jointcal.measure.frf.frf_table`). A run with problems gets flags and a one-sentence warning, never a
-silent drop.
+silent drop. `run_modal_unit` then cuts one (assembly, mode)'s rows out of the three tables, the files the
+later stages of that unit read.
 """
 from __future__ import annotations
 
@@ -17,6 +18,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from .._campaign_index import unit_table
 from ..io import listed_record, read_run, write_csv_atomic
 from .campaign import campaign_modal
 from .flags import run_flags
@@ -24,7 +26,7 @@ from .frf import frf_table
 from .scatter import scatter
 from .testkinds import backbone_table
 
-__all__ = ["run_modal"]
+__all__ = ["run_modal", "run_modal_unit"]
 
 _Path = str | os.PathLike[str]
 
@@ -85,3 +87,36 @@ def run_modal(runs_csv: _Path, envelope_files: Sequence[_Path], record_files: Se
     for n in notes:
         warn(n)
     return table
+
+
+def run_modal_unit(table_csv: _Path, scatter_csv: _Path, backbone_csv: _Path, assembly: str, mode: str, *,
+                   unit_table_csv: _Path, unit_scatter_csv: _Path, unit_backbone_csv: _Path) -> str:
+    """Write one (assembly, mode)'s rows of ``modal_properties.csv``, ``scatter.csv`` and ``backbone.csv``.
+
+    Parameters
+    ----------
+    table_csv, scatter_csv, backbone_csv : path
+        The modal stage's three tables (`run_modal`).
+    assembly, mode : str
+        The unit (a mode's name as `jointcal.measure.modes.mode_name` gives it, e.g. ``m18``).
+    unit_table_csv, unit_scatter_csv, unit_backbone_csv : path
+        Where the unit's rows go: its runs' rows of the table (`jointcal._campaign_index.unit_table`), its
+        scatter rows, and its runs' backbone points of that mode.
+
+    Returns
+    -------
+    str
+        The line for the log: the unit and its runs.
+    """
+    table = pd.read_csv(table_csv, dtype={"assembly": str, "mode": str, "flags": str})
+    scatter_rows = pd.read_csv(scatter_csv, dtype={"assembly": str, "mode": str})
+    rows = unit_table(table, assembly, mode)
+    write_csv_atomic(rows, unit_table_csv)
+    keep = scatter_rows["assembly"] == assembly
+    if "mode" in scatter_rows.columns:  # (a table made before modes were tracked holds one per assembly)
+        keep &= scatter_rows["mode"] == mode
+    write_csv_atomic(scatter_rows[keep], unit_scatter_csv)
+    backbone = pd.read_csv(backbone_csv, dtype={"run_id": str, "mode": str, "test": str})
+    write_csv_atomic(backbone[backbone["run_id"].isin(rows["run_id"].astype(str)) & (backbone["mode"] == mode)],
+                     unit_backbone_csv)
+    return f"{assembly} {mode}: {len(rows)} runs ({', '.join(rows['run_id'])})"
