@@ -17,7 +17,7 @@ from types import SimpleNamespace
 
 import pytest
 import yaml
-from _campaign import SMALL_CAMPAIGN
+from tests._support.campaign import SMALL_CAMPAIGN
 
 from jointcal import cli
 from jointcal._campaign_index import campaign_index

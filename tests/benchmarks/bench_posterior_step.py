@@ -19,8 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from _modal_tables import TABLE_3_2, modal_tables  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+from tests._support.modal_tables import TABLE_3_2, modal_tables  # noqa: E402
 
 from jointcal.calibrate import CalibrateSettings, objective, select_modal  # noqa: E402
 from jointcal.calibrate.space import PARAMS  # noqa: E402

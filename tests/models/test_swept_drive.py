@@ -25,7 +25,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from _rigs import levels_V, rig, truth_curve
+from tests._support.rigs import levels_V, rig, truth_curve
 from jointcal.discrepancy.data import run_envelope, run_zeta, scale_arrays
 from jointcal.discrepancy.fit import observed
 from jointcal.measure.modal import measure_run

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from _kinds_records import FN, GAIN, ZETA, linear_dwell
+from tests._support.kinds_records import FN, GAIN, ZETA, linear_dwell
 
 from jointcal.measure.ringdown import decay_start, ringdown_backbone
 from jointcal.models import MinistackModel
