@@ -34,8 +34,13 @@ named in >= 2 of 3 seeds. NOT MET. Measured 2026-11-26, seed 1 only, on a loaded
     contact_spring                       force    seed 1: unexplained                          low    E  22.18 -> 11.29 ( -49%)  floor 1.04, stage 42 s
     contact_spring                       voltage  seed 1: unexplained                          low    E  14.91 ->  4.59 ( -69%)  floor 0.22, stage 60 s
 
-The force rig's floor (E 3-8 on its eta-2 runs) is the open-loop force's dip at resonance: five-fold within a few
-cycles, its phase turning with it, which the fast model's frame-by-frame drive magnitude does not follow.
+The force rig's floor (E 3-8 on its eta-2 runs) was the open-loop force's dip at resonance: five-fold within a few
+cycles, its phase turning with it, which a drive of frame magnitudes alone did not follow. With the drive's complex
+envelope (merge of 2026-11-26, `models.swept`: |A| e^{i psi}) the first two force rows, rerun (seed 1, loaded machine;
+the other rows not rerun yet):
+
+    none                                 force    seed 1: none                                 high   E   0.59 ->  0.58 (  -2%)  floor 0.25, stage 131 s
+    cubic_stiffening                     force    seed 1: cubic_stiffening                     high   E  10.53 ->  0.57 ( -95%)  floor 0.24, stage 172 s
 """
 import argparse
 import json
