@@ -1,7 +1,6 @@
 """The modal stage's figures on files: Figs. 3.5 and 3.6 and a spectrogram (rule ``modal_figures``).
 
-Kept apart from `jointcal.report.figures_stage` (the later stages' figures), so that this rule's code hash
-(`jointcal._workflow.stage_hash`) holds no stage after modal.
+Its own module, so that this rule's code hash (`jointcal._workflow.stage_hash`) holds no stage after modal.
 """
 from __future__ import annotations
 
