@@ -36,11 +36,13 @@ named in >= 2 of 3 seeds. NOT MET. Measured 2026-11-26, seed 1 only, on a loaded
 
 The force rig's floor (E 3-8 on its eta-2 runs) was the open-loop force's dip at resonance: five-fold within a few
 cycles, its phase turning with it, which a drive of frame magnitudes alone did not follow. With the drive's complex
-envelope (merge of 2026-11-26, `models.swept`: |A| e^{i psi}) the first two force rows, rerun (seed 1, loaded machine;
+envelope (merge of 2026-11-26, `models.swept`: |A| e^{i psi}) four force rows, rerun (seed 1, loaded machine;
 the other rows not rerun yet):
 
     none                                 force    seed 1: none                                 high   E   0.59 ->  0.58 (  -2%)  floor 0.25, stage 131 s
     cubic_stiffening                     force    seed 1: cubic_stiffening                     high   E  10.53 ->  0.57 ( -95%)  floor 0.24, stage 172 s
+    elastic_softening                    force    seed 1: elastic_softening                    high   E   8.87 ->  0.70 ( -92%)  floor 0.35, stage 626 s (niced behind the suite)
+    joint_settling                       force    seed 1: unexplained                          low    E   5.40 ->  3.16 ( -41%)  floor 0.24, stage 137 s
 """
 import argparse
 import json
