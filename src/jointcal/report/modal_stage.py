@@ -1,6 +1,7 @@
 """The modal stage's figures on files: Figs. 3.5 and 3.6 and a spectrogram (rule ``modal_figures``).
 
-Its own module, so that this rule's code hash (`jointcal._workflow.stage_hash`) holds no stage after modal.
+One module per report rule, so that each rule's code hash (`jointcal._workflow.stage_hash`) holds the
+code it runs and no more (this one: no stage after modal).
 """
 from __future__ import annotations
 
