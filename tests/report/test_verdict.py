@@ -142,3 +142,18 @@ def test_verdict_without_a_named_effect_reports_the_paper_models_identified_quan
     assert a2 == "The discrepancy stage did not run."  # it runs for every excitation: absent only when not run
     assert "K0 = k + KT 1.63e6 [1.62e6, 1.64e6] lbf/in" in a3 and "Fs" in a3.split("Left to the bounds")[1]
     assert "No level recommended" in a4 and "force-driven" in a4
+
+
+@pytest.mark.parametrize("floor, said", [(30.1, True), (0.25, False), (None, False)])
+def test_an_unexplained_item_states_the_fast_models_floor_when_it_is_above_the_scatter(floor, said):
+    # UNESP mode 1's chirps (eta 200-600): the fast model is E = 30 from its own time simulation, which is why
+    # nothing is named there; below the repeat scatter the floor is no part of the answer
+    diag = {"effect": "unexplained", "confidence": "low", "metric_before": 9.36, "metric_after": 9.15,
+            "outside_library": "the 2nd-harmonic fingerprint is 1.1% of the fundamental",
+            "fast_model_floor": {"E": floor}}
+    items = verdict_items(best={"model_kind": "modal", "excitation": "voltage"}, identified=_identified(),
+                          validation={"E": 9.36}, fit={"fit_chi2": 9.767, "fit_dof": 6.0, "fit_p": 0.13},
+                          diagnosis=diag, next_test=NOT_APPLICABLE)
+    a2 = items[1][1]
+    assert a2.startswith("Unexplained") and "9.36" in a2
+    assert ("E = 30.10 from the time simulation" in a2) is said

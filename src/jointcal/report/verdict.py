@@ -29,6 +29,7 @@ import numpy as np
 import pandas as pd
 
 from ..calibrate.space import PARAMS
+from ..discrepancy.rule import FLOOR_HIGH
 from ..effects import EFFECTS
 from ..posterior.noise import scale_words as noise_words
 from ..posterior.stage import P_REJECT
@@ -136,10 +137,21 @@ def _item2(diagnosis: Mapping | None, best: Mapping) -> str:
                 f"({closeness(E1)}), checked with the time simulation driven by each run's measured reference record."
                 + (f" What it means: {means}" if means else ""))
     if diagnosis.get("effect") == "none":
-        return f"No missing effect: the paper's model predicts the levels it did not see within the scatter (E = {E0:.2f})."
+        return (f"No missing effect: the paper's model predicts the levels it did not see within the scatter "
+                f"(E = {E0:.2f}).{_floor_words(diagnosis)}")
     return (f"Unexplained: no library effect closes the gap decisively (E = {E0:.2f}); "
             + html.escape(str(diagnosis.get("outside_library") or "look for a second effect or one outside the library"))
-            + ".")
+            + "." + _floor_words(diagnosis))
+
+
+def _floor_words(diagnosis: Mapping) -> str:
+    """A sentence on the fast model's own error when it is above the repeat scatter (`rule.FLOOR_HIGH`), else ""."""
+    floor = (diagnosis.get("fast_model_floor") or {}).get("E")
+    if floor is None or float(floor) <= FLOOR_HIGH:
+        return ""
+    return (f" The fast envelope model the stage scores with is itself E = {float(floor):.2f} from the time "
+            f"simulation of the calibrated model on these runs, so an effect smaller than that cannot be told apart "
+            f"here; slower sweeps bring that floor down.")
 
 
 def corrected_holds(diagnosis: Mapping | None) -> bool:
