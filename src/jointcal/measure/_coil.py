@@ -31,14 +31,11 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
+from ._rotating_sensitivity import _dacc_row, _mode_terms, _tangent_stage, _tangent_step
+
 __all__ = ["coil_mode_sensitivity", "coil_pole", "N_COIL_DIRECTIONS"]
 
 N_COIL_DIRECTIONS = 18
-
-
-@numba.njit(cache=True, inline="always")
-def _put(g, k, v):
-    g[0, k], g[1, k] = v.real, v.imag
 
 
 @numba.njit(cache=True, inline="always")
@@ -49,43 +46,19 @@ def _put_u(g, k, v):
 @numba.njit(cache=True, inline="always")
 def _stage(z, y, u, r, rd, w0, p, q_ref, l_lo, l_hi, dirs, t, out, g):
     """Z'' and U' at (z, y, u), and in out (4, m: Re, Im of d Z'', then of d U') their derivatives along
-    each direction given the stage's state derivatives t (6, m: Re, Im of dZ, dZ', dU); g: work, 4 x 18."""
-    az = abs(z)
-    L = np.log(max(az, 1e-300) / q_ref)
-    inside = l_lo < L < l_hi and az > 0.0
-    L = min(max(L, l_lo), l_hi)
-    w2 = p[0] * np.exp(p[2] * L + p[3] * L * L + p[11] * L * L * L)
-    d = p[1] * np.exp(p[4] * L + p[5] * L * L)  # 2 zeta Omega at q
-    phi = p[8]
-    c = (1.0 - phi) * d
-    sw = np.sqrt(w2)
-    stiff = w2 - w0 * w0 + 1j * (c * w0 + phi * d * sw)
-    visc = 2j * w0 + c
+    each direction given the stage's state derivatives t (6, m: Re, Im of dZ, dZ', dU); g: work, 4 x 18.
+    The mode's own terms are the rotating kernel's (`_rotating_sensitivity._mode_terms`)."""
+    stiff, visc, force, c00, c01, c10, c11 = _mode_terms(z, y, r, rd, w0, p, q_ref, l_lo, l_hi, g)
     we, gb = p[12], p[13]
     ew = we + 1j * w0
-    force = (p[6] + 1j * p[7]) * r - 1j * (p[9] + 1j * p[10]) * rd / w0  # A(w) r_a in the frame
     a = u - visc * y - stiff * z
     b = ew * (force - u) - gb * (y + 1j * w0 * z)
-    gw = -(w2 + 0.5j * phi * d * sw) * z  # d a / d ln Omega^2
-    gd = -d * ((1.0 - phi) * y + 1j * ((1.0 - phi) * w0 + phi * sw) * z)  # d a / d ln D
-    _put(g, 0, gw)
-    _put(g, 1, gd)
-    _put(g, 2, gw * L)
-    _put(g, 3, gw * L * L)
-    _put(g, 4, gd * L)
-    _put(g, 5, gd * L * L)
-    _put(g, 8, d * y - 1j * d * (sw - w0) * z)
-    _put(g, 11, gw * L * L * L)
     _put_u(g, 6, ew * r)
     _put_u(g, 7, 1j * ew * r)
     _put_u(g, 9, -1j * ew * rd / w0)
     _put_u(g, 10, ew * rd / w0)
     _put_u(g, 16, we * (force - u))
     _put_u(g, 17, -(y + 1j * w0 * z))
-    f_l = (gw * (p[2] + 2.0 * p[3] * L + 3.0 * p[11] * L * L) + gd * (p[4] + 2.0 * p[5] * L)) / (az * az) \
-        if inside else 0j
-    c00, c01 = -stiff.real + f_l.real * z.real, stiff.imag + f_l.real * z.imag
-    c10, c11 = -stiff.imag + f_l.imag * z.real, -stiff.real + f_l.imag * z.imag
     for j in range(dirs.size):
         k = dirs[j]
         # d a = -stiff dZ - visc dZ' + f_l Re(conj(z) dZ) + dU
@@ -167,41 +140,19 @@ def coil_mode_sensitivity(r, rd, rm, rdm, w0, h, p, q_ref, l_lo, l_hi, z0, y0, n
         Z[k] = z
         acc[k] = a1 + 2j * w0 * y - w0 * w0 * z
         if i_row < rows.size and rows[i_row] == k:
-            for i in range(chain.shape[1]):
-                t_re, t_im = 0.0, 0.0
-                for j in range(m):  # d acc = d a + 2 i w0 dZ' - w0^2 dZ
-                    t_re += chain[j, i] * (d1[0, j] - 2.0 * w0 * st[3, j] - w0 * w0 * st[0, j])
-                    t_im += chain[j, i] * (d1[1, j] + 2.0 * w0 * st[2, j] - w0 * w0 * st[1, j])
-                dacc[i_row, i] = t_re + 1j * t_im
+            _dacc_row(dacc, i_row, chain, d1, st, w0)
             i_row += 1
         if k == n - 1:
             break
-        for q in range(2):
-            for j in range(m):
-                t[q, j] = st[q, j] + hh * st[q + 2, j]
-                t[q + 2, j] = st[q + 2, j] + hh * d1[q, j]
-                t[q + 4, j] = st[q + 4, j] + hh * d1[q + 2, j]
+        _tangent_stage(t, st, d1, d1, hh, 0.0)
         a2, b2 = _stage(z + hh * y, y + hh * a1, u + hh * b1, rm[k], rdm[k], w0, p, q_ref, l_lo, l_hi, dirs, t, d2, g)
-        for q in range(2):
-            for j in range(m):
-                t[q, j] = st[q, j] + hh * (st[q + 2, j] + hh * d1[q, j])
-                t[q + 2, j] = st[q + 2, j] + hh * d2[q, j]
-                t[q + 4, j] = st[q + 4, j] + hh * d2[q + 2, j]
+        _tangent_stage(t, st, d1, d2, hh, hh)
         a3, b3 = _stage(z + hh * (y + hh * a1), y + hh * a2, u + hh * b2, rm[k], rdm[k], w0, p, q_ref, l_lo, l_hi,
                         dirs, t, d3, g)
-        for q in range(2):
-            for j in range(m):
-                t[q, j] = st[q, j] + h * (st[q + 2, j] + hh * d2[q, j])
-                t[q + 2, j] = st[q + 2, j] + h * d3[q, j]
-                t[q + 4, j] = st[q + 4, j] + h * d3[q + 2, j]
+        _tangent_stage(t, st, d2, d3, h, hh)
         a4, b4 = _stage(z + h * (y + hh * a2), y + h * a3, u + h * b3, r[k + 1], rd[k + 1], w0, p, q_ref, l_lo, l_hi,
                         dirs, t, d4, g)
-        for q in range(2):
-            for j in range(m):
-                st[q, j] = st[q, j] + h * st[q + 2, j] + h * h / 6.0 * (d1[q, j] + d2[q, j] + d3[q, j])
-                st[q + 2, j] = st[q + 2, j] + h / 6.0 * (d1[q, j] + 2.0 * d2[q, j] + 2.0 * d3[q, j] + d4[q, j])
-                st[q + 4, j] = st[q + 4, j] + h / 6.0 * (d1[q + 2, j] + 2.0 * d2[q + 2, j] + 2.0 * d3[q + 2, j]
-                                                         + d4[q + 2, j])
+        _tangent_step(st, d1, d2, d3, d4, h)
         z = z + h * y + h * h / 6.0 * (a1 + a2 + a3)
         y = y + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
         u = u + h / 6.0 * (b1 + 2.0 * b2 + 2.0 * b3 + b4)

@@ -36,10 +36,11 @@ def _put(g, k, v):
 
 
 @numba.njit(cache=True, inline="always")
-def _stage(z, y, r, rd, w0, p, q_ref, l_lo, l_hi, dirs, t, out, g):
-    """The equation's right-hand side Z'' at (z, y), and in out (2, m: real and imaginary parts) its derivative
-    along each direction given the stage's state derivatives t (4, m: Re dZ, Im dZ, Re dZ', Im dZ'):
-    `_rotating._rhs` with its chain rule (g: work space, 2 x 16)."""
+def _mode_terms(z, y, r, rd, w0, p, q_ref, l_lo, l_hi, g):
+    """The mode's own terms at (z, y), shared with the coil's kernel (`jointcal.measure._coil`): the
+    stiffness and viscous coefficients of Z'' = force - visc Z' - stiff Z, the drive's force, the directions'
+    own terms of the mode's coefficients (ln p[0], ln p[1], p[2]-p[5], p[8], p[11]) written into g[0:2], and
+    the real 2 x 2 map (c00, c01, c10, c11) of d Z'' on (Re dZ, Im dZ) with the amplitude's share."""
     az = abs(z)
     L = np.log(max(az, 1e-300) / q_ref)
     inside = l_lo < L < l_hi and az > 0.0
@@ -52,21 +53,16 @@ def _stage(z, y, r, rd, w0, p, q_ref, l_lo, l_hi, dirs, t, out, g):
     stiff = w2 - w0 * w0 + 1j * (c * w0 + phi * d * sw)
     visc = 2j * w0 + c
     force = (p[6] + 1j * p[7]) * r - 1j * (p[9] + 1j * p[10]) * rd / w0  # A(w) r_a in the frame
-    a = force - visc * y - stiff * z
     gw = -(w2 + 0.5j * phi * d * sw) * z  # d a / d ln Omega^2
     gd = -d * ((1.0 - phi) * y + 1j * ((1.0 - phi) * w0 + phi * sw) * z)  # d a / d ln D
-    # each direction's own term (the state's aside): ln p[0], ln p[1], p[2], ..., p[11]
+    # each direction's own term (the state's aside): ln p[0], ln p[1], p[2], ..., p[5], p[8], p[11]
     _put(g, 0, gw)
     _put(g, 1, gd)
     _put(g, 2, gw * L)
     _put(g, 3, gw * L * L)
     _put(g, 4, gd * L)
     _put(g, 5, gd * L * L)
-    _put(g, 6, r)
-    _put(g, 7, 1j * r)
     _put(g, 8, d * y - 1j * d * (sw - w0) * z)
-    _put(g, 9, -1j * rd / w0)
-    _put(g, 10, rd / w0)
     _put(g, 11, gw * L * L * L)
     # the amplitude's share: d a / d L times dL = Re(conj(z) dz) / |z|^2, zero where L is held
     f_l = (gw * (p[2] + 2.0 * p[3] * L + 3.0 * p[11] * L * L) + gd * (p[4] + 2.0 * p[5] * L)) / (az * az) \
@@ -74,12 +70,62 @@ def _stage(z, y, r, rd, w0, p, q_ref, l_lo, l_hi, dirs, t, out, g):
     # d a = -stiff dZ - visc dZ' + f_l Re(conj(z) dZ), as real 2 x 4 coefficients
     c00, c01 = -stiff.real + f_l.real * z.real, stiff.imag + f_l.real * z.imag
     c10, c11 = -stiff.imag + f_l.imag * z.real, -stiff.real + f_l.imag * z.imag
+    return stiff, visc, force, c00, c01, c10, c11
+
+
+@numba.njit(cache=True, inline="always")
+def _stage(z, y, r, rd, w0, p, q_ref, l_lo, l_hi, dirs, t, out, g):
+    """The equation's right-hand side Z'' at (z, y), and in out (2, m: real and imaginary parts) its derivative
+    along each direction given the stage's state derivatives t (4, m: Re dZ, Im dZ, Re dZ', Im dZ'):
+    `_rotating._rhs` with its chain rule (g: work space, 2 x 16)."""
+    stiff, visc, force, c00, c01, c10, c11 = _mode_terms(z, y, r, rd, w0, p, q_ref, l_lo, l_hi, g)
+    a = force - visc * y - stiff * z
+    _put(g, 6, r)
+    _put(g, 7, 1j * r)
+    _put(g, 9, -1j * rd / w0)
+    _put(g, 10, rd / w0)
     for j in range(dirs.size):
         out[0, j], out[1, j] = g[0, dirs[j]], g[1, dirs[j]]
     for j in range(dirs.size):
         out[0, j] += c00 * t[0, j] + c01 * t[1, j] - visc.real * t[2, j] + visc.imag * t[3, j]
         out[1, j] += c10 * t[0, j] + c11 * t[1, j] - visc.imag * t[2, j] - visc.real * t[3, j]
     return a
+
+
+@numba.njit(cache=True, inline="always")
+def _dacc_row(dacc, i_row, chain, d1, st, w0):
+    """Row i_row of d acc / d parameter: d acc = d Z'' + 2 i w0 dZ' - w0^2 dZ along the chain's combinations."""
+    for i in range(chain.shape[1]):
+        t_re, t_im = 0.0, 0.0
+        for j in range(chain.shape[0]):
+            t_re += chain[j, i] * (d1[0, j] - 2.0 * w0 * st[3, j] - w0 * w0 * st[0, j])
+            t_im += chain[j, i] * (d1[1, j] + 2.0 * w0 * st[2, j] - w0 * w0 * st[1, j])
+        dacc[i_row, i] = t_re + 1j * t_im
+
+
+@numba.njit(cache=True, inline="always")
+def _tangent_stage(t, st, dp, dv, c, e):
+    """The state derivatives at an RK4 stage, into t: dZ + c (dZ' + e dp), dZ' + c dv, and any first-order
+    rows past the fourth (the coil's dU) + c times dv's rows past the second."""
+    for q in range(2):
+        for j in range(st.shape[1]):
+            t[q, j] = st[q, j] + c * (st[q + 2, j] + e * dp[q, j])
+            t[q + 2, j] = st[q + 2, j] + c * dv[q, j]
+    for q in range(4, st.shape[0]):
+        for j in range(st.shape[1]):
+            t[q, j] = st[q, j] + c * dv[q - 2, j]
+
+
+@numba.njit(cache=True, inline="always")
+def _tangent_step(st, d1, d2, d3, d4, h):
+    """The state derivatives' RK4 step, in place (the same weights as the state's own step)."""
+    for q in range(2):
+        for j in range(st.shape[1]):
+            st[q, j] = st[q, j] + h * st[q + 2, j] + h * h / 6.0 * (d1[q, j] + d2[q, j] + d3[q, j])
+            st[q + 2, j] = st[q + 2, j] + h / 6.0 * (d1[q, j] + 2.0 * d2[q, j] + 2.0 * d3[q, j] + d4[q, j])
+    for q in range(4, st.shape[0]):
+        for j in range(st.shape[1]):
+            st[q, j] = st[q, j] + h / 6.0 * (d1[q - 2, j] + 2.0 * d2[q - 2, j] + 2.0 * d3[q - 2, j] + d4[q - 2, j])
 
 
 @numba.njit(cache=True)
@@ -134,34 +180,17 @@ def rotating_mode_sensitivity(r, rd, rm, rdm, w0, h, p, q_ref, l_lo, l_hi, z0, y
         Z[k] = z
         acc[k] = a1 + 2j * w0 * y - w0 * w0 * z
         if i_row < rows.size and rows[i_row] == k:
-            for i in range(chain.shape[1]):
-                t_re, t_im = 0.0, 0.0
-                for j in range(m):  # d acc = d a + 2 i w0 dZ' - w0^2 dZ
-                    t_re += chain[j, i] * (d1[0, j] - 2.0 * w0 * st[3, j] - w0 * w0 * st[0, j])
-                    t_im += chain[j, i] * (d1[1, j] + 2.0 * w0 * st[2, j] - w0 * w0 * st[1, j])
-                dacc[i_row, i] = t_re + 1j * t_im
+            _dacc_row(dacc, i_row, chain, d1, st, w0)
             i_row += 1
         if k == n - 1:
             break
-        for q in range(2):
-            for j in range(m):
-                t[q, j] = st[q, j] + hh * st[q + 2, j]
-                t[q + 2, j] = st[q + 2, j] + hh * d1[q, j]
+        _tangent_stage(t, st, d1, d1, hh, 0.0)
         a2 = _stage(z + hh * y, y + hh * a1, rm[k], rdm[k], w0, p, q_ref, l_lo, l_hi, dirs, t, d2, g)
-        for q in range(2):
-            for j in range(m):
-                t[q, j] = st[q, j] + hh * (st[q + 2, j] + hh * d1[q, j])
-                t[q + 2, j] = st[q + 2, j] + hh * d2[q, j]
+        _tangent_stage(t, st, d1, d2, hh, hh)
         a3 = _stage(z + hh * (y + hh * a1), y + hh * a2, rm[k], rdm[k], w0, p, q_ref, l_lo, l_hi, dirs, t, d3, g)
-        for q in range(2):
-            for j in range(m):
-                t[q, j] = st[q, j] + h * (st[q + 2, j] + hh * d2[q, j])
-                t[q + 2, j] = st[q + 2, j] + h * d3[q, j]
+        _tangent_stage(t, st, d2, d3, h, hh)
         a4 = _stage(z + h * (y + hh * a2), y + h * a3, r[k + 1], rd[k + 1], w0, p, q_ref, l_lo, l_hi, dirs, t, d4, g)
-        for q in range(2):
-            for j in range(m):
-                st[q, j] = st[q, j] + h * st[q + 2, j] + h * h / 6.0 * (d1[q, j] + d2[q, j] + d3[q, j])
-                st[q + 2, j] = st[q + 2, j] + h / 6.0 * (d1[q, j] + 2.0 * d2[q, j] + 2.0 * d3[q, j] + d4[q, j])
+        _tangent_step(st, d1, d2, d3, d4, h)
         z = z + h * y + h * h / 6.0 * (a1 + a2 + a3)
         y = y + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
     return Z, acc, dacc
