@@ -137,11 +137,9 @@ def _cmd_modal(args: argparse.Namespace) -> int:
 
     config, out, env = read_config(args.config), Path(args.out), Path(args.envelopes)
     with console_job() as job:
-        table = run_modal(args.runs, [env / f"{r}.csv" for r in _run_ids(args.runs)], _records(args.campaign_dir),
-                          config["modal"], table_csv=out / "modal_properties.csv", scatter_csv=out / "scatter.csv",
-                          backbone_csv=out / "backbone.csv", frf_dir=out / "frf", warn=job.warn)
-        job.log(f"modal properties of {table['run_id'].nunique()} runs at {table['mode'].nunique()} modes, "
-                f"{sum(table['flags'].fillna('') != '')} rows flagged")
+        run_modal(args.runs, [env / f"{r}.csv" for r in _run_ids(args.runs)], _records(args.campaign_dir),
+                  config["modal"], table_csv=out / "modal_properties.csv", scatter_csv=out / "scatter.csv",
+                  backbone_csv=out / "backbone.csv", frf_dir=out / "frf", warn=job.warn, log=job.log)
     return 0
 
 

@@ -10,8 +10,6 @@ from jointcal.measure.stage import run_modal
 
 with stage_job(snakemake) as job:  # noqa: F821 (provided by Snakemake)
     smk = job.smk
-    table = run_modal(smk.input.runs, smk.input.env, smk.input.records, smk.params.modal,
-                      table_csv=smk.output.table, scatter_csv=smk.output.scatter,
-                      backbone_csv=smk.output.backbone, frf_dir=smk.output.frf, warn=job.warn)
-    job.log(f"modal properties of {table['run_id'].nunique()} runs at {table['mode'].nunique()} modes, "
-            f"{sum(table['flags'].fillna('') != '')} rows flagged")
+    run_modal(smk.input.runs, smk.input.env, smk.input.records, smk.params.modal, table_csv=smk.output.table,
+              scatter_csv=smk.output.scatter, backbone_csv=smk.output.backbone, frf_dir=smk.output.frf,
+              warn=job.warn, log=job.log)

@@ -33,7 +33,8 @@ _Path = str | os.PathLike[str]
 
 def run_modal(runs_csv: _Path, envelope_files: Sequence[_Path], record_files: Sequence[_Path],
               modal: Mapping, *, table_csv: _Path, scatter_csv: _Path, backbone_csv: _Path, frf_dir: _Path,
-              warn: Callable[[str], None] = lambda s: None) -> pd.DataFrame:
+              warn: Callable[[str], None] = lambda s: None,
+              log: Callable[[str], None] = lambda s: None) -> pd.DataFrame:
     """Read every run of the campaign at each mode its band holds, and write the stage's files.
 
     Parameters
@@ -53,6 +54,8 @@ def run_modal(runs_csv: _Path, envelope_files: Sequence[_Path], record_files: Se
         The folder of per-run FRF tables (made if absent).
     warn : callable, optional
         Receives each run's problem in one sentence.
+    log : callable, optional
+        Receives the stage's closing line (runs, modes, rows flagged).
 
     Returns
     -------
@@ -86,6 +89,8 @@ def run_modal(runs_csv: _Path, envelope_files: Sequence[_Path], record_files: Se
     write_csv_atomic(backbone_table(table, points), backbone_csv)
     for n in notes:
         warn(n)
+    log(f"modal properties of {table['run_id'].nunique()} runs at {table['mode'].nunique()} modes, "
+        f"{sum(table['flags'].fillna('') != '')} rows flagged")
     return table
 
 
