@@ -63,3 +63,30 @@ def test_a_voltage_driven_real_campaign_runs_end_to_end_with_the_default_config(
     print(f"verdict: {answer}; chi-square {chi2:.4g} for {dof} dof, p = {p:.2g}; E = {summary['E']:.3g}")
     assert (answer == "Yes") == (p >= P_REJECT and summary["E"] <= HOLDS_E)
     assert f"chi-square {fmt(chi2)} for {dof} degrees of freedom" in page  # the test the answer stands on
+
+
+DWELL = REAL.parent / "unesp-bert-dwell-mode1"
+
+
+@pytest.mark.skipif(not DWELL.is_dir(), reason=f"the real dwell records are not at {DWELL}")
+def test_the_real_dwell_campaign_runs_end_to_end_with_the_default_config(tmp_path, workdir):
+    # the lab's five Test.Lab exports as they were handed over, in a manifest that points at them (nothing copied):
+    # the ring-downs after each dwell are read, calibrated, validated as they were done, and diagnosed
+    from tests.benchmarks.real_dwell_campaign import write_campaign
+
+    camp = tmp_path / "campaign"
+    write_campaign(camp)
+    out = tmp_path / "results"
+    res = snakemake(workdir, "--cores", "2", "--config", f"raw_data={camp}", f"results={out}")
+    assert res.returncode == 0, res.stderr[-3000:]
+    bb = pd.read_csv(out / "modal" / "backbone.csv")
+    rd = bb[bb["test"] == "ringdown"]
+    assert rd["run_id"].nunique() == 5 and (rd.groupby("run_id")["q_in"].agg(lambda q: np.log10(q.max() / q.min()))
+                                            > 1.5).all()
+    summary = json.loads((out / "validation" / "bert" / "m18" / "summary.json").read_text())
+    assert np.isfinite(summary["E"]) and "free decays" in summary["words"]
+    diag = json.loads((out / "discrepancy" / "bert" / "m18" / "diagnosis.json").read_text())
+    print(f"\nvalidation E {summary['E']:.3g} (f {summary['E_f']:.3g}, zeta {summary['E_zeta']:.3g}); discrepancy: "
+          f"{diag['effect']} ({diag.get('confidence')}), E {diag['metric_before']:.3g} -> {diag['metric_after']:.3g}")
+    page = (out / "report" / "summary.html").read_text()
+    assert re.search(r"reproduce the measured envelopes\?</b> <b>(Yes|No)</b>", page)
