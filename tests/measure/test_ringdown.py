@@ -89,3 +89,34 @@ def test_a_record_without_a_free_decay_is_said():
         decay_start(fs, drive, drive)
     with pytest.raises(ValueError, match="Nyquist"):
         ringdown_backbone(drive, fs, 600.0, start=0)
+
+
+def test_a_force_gauge_left_on_the_shaker_reads_past_the_cut_and_the_decay_still_starts_at_it(tmp_path):
+    # the force-driven beam of tests/_support/rigs.py dwelt at its resonance, then its voltage cut: the gauge goes on
+    # reading the armature's reaction (at first above the dwell's force) while the structure rings down, so the
+    # reference's last sample above DRIVE_OFF lies deep in the decay (before: a CampaignError at ingest, "the
+    # drive's frequency over the dwell is 611 Hz", and a decay start in the noise)
+    from jointcal.io import ingest_campaign, read_run
+    from jointcal.spectral import DRIVE_OFF
+    from jointcal.synth import generate
+    from tests._support import rigs
+
+    f, _ = rigs.truth_curve("force", rigs.Q_TARGETS[1])
+    dwell_s = 1.5
+    generate({"seed": 3, "sample_rate_hz": 2048.0, "measurement": {"noise_fraction": 0.02},
+              "sweep": {"f_start_hz": 0.7 * f, "f_stop_hz": 1.3 * f, "rate_hz_per_s": 1.0},  # (the spec's band)
+              "series": [{"level_V": rigs.levels_V()[1], "test": "dwell", "dwell_hz": [round(f, 3)],
+                          "dwell_s": dwell_s, "decay_s": 2.5}],
+              "assemblies": {"beam": rigs.JOINTED_BEAM},
+              "rig": {"reference": "force", "shaker": rigs.SMALL_SHAKER, "second_mode": rigs.SECOND_MODE}},
+             tmp_path / "c", tmp_path / "t.json")
+    row = ingest_campaign(tmp_path / "c").iloc[0].to_dict()  # the dwell's frequency read over the dwell
+    rec = read_run(tmp_path / "c" / row["file"], row)
+    fs, force = row["sample_rate_hz"], rec["force_lbf"].to_numpy()
+    late = np.flatnonzero(np.abs(force - np.median(force)) > DRIVE_OFF * np.abs(force).max())[-1] / fs
+    assert late > dwell_s + 0.3  # the gauge stays live well past the cut
+    from scipy import signal
+    sos = signal.butter(4, [0.7 * f, 1.3 * f], "bandpass", fs=fs, output="sos")
+    y = signal.sosfiltfilt(sos, rec["response_accel_g"].to_numpy())
+    t0 = decay_start(fs, y, force - np.median(force)) / fs
+    assert abs(t0 - dwell_s) <= 3 / f  # within three periods of the cut

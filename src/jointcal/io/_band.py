@@ -8,7 +8,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from jointcal.io.contract import MIN_CYCLES, fail
-from jointcal.spectral import peak_frequency
+from jointcal.spectral import DRIVE_OFF, drive_end, peak_frequency
 
 __all__ = ["drive_band", "check_head", "dwell_band"]
 
@@ -63,12 +63,11 @@ def drive_band(ref: NDArray[np.float64], fs: float, f0: float, f1: float,
     return f_first, f_last, tol
 
 
-DRIVE_OFF = 0.02  # a drive below this share of its largest value is cut off (as measure.ringdown.DRIVE_OFF)
 TINY = 1e-9  # a dwell is checked as a sweep over this relative band: the sweep's windows, one frequency
 
 
 def dwell_band(drive: NDArray[np.float64], fs: float, f_d: float, path: object,
-               run: str) -> tuple[float, float, float, float]:
+               run: str, response: NDArray[np.float64] | None = None) -> tuple[float, float, float, float]:
     """A dwell's drive checked against ``dwell_hz``, and the equivalent sweep its amplitude checks use.
 
     Parameters
@@ -79,6 +78,9 @@ def dwell_band(drive: NDArray[np.float64], fs: float, f_d: float, path: object,
         Sample rate and the manifest's ``dwell_hz`` (Hz).
     path, run : object, str
         Named in messages.
+    response : ndarray of float, shape (n,), optional
+        The response: where the drive stays live after the cut (a force gauge on a shaker left
+        attached), the dwell ends where the response's steady state does (`jointcal.spectral.drive_end`).
 
     Returns
     -------
@@ -95,8 +97,11 @@ def dwell_band(drive: NDArray[np.float64], fs: float, f_d: float, path: object,
         FFT bin of the half plus 0.1 %.
     """
     x = np.nan_to_num(np.asarray(drive, float) - np.nanmedian(drive))
-    on = np.flatnonzero(np.abs(x) > DRIVE_OFF * np.max(np.abs(x))) if x.size else np.empty(0, int)
-    end = int(on[-1]) + 1 if on.size else x.size
+    if response is None:
+        on = np.flatnonzero(np.abs(x) > DRIVE_OFF * np.max(np.abs(x))) if x.size else np.empty(0, int)
+        end = int(on[-1]) + 1 if on.size else x.size
+    else:
+        end = drive_end(fs, x, np.nan_to_num(np.asarray(response, float))) or x.size
     if end / fs * f_d < 2 * MIN_CYCLES:
         fail(path, f"the drive of dwell run {run} lasts {end / fs:.3g} s, fewer than {2 * MIN_CYCLES} cycles at "
              f"dwell_hz = {f_d:g} Hz", f"record a longer dwell or correct dwell_hz of run {run}")

@@ -121,7 +121,7 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
         return _ringdown_checks(t, chans, fs, kind, clip_run, path, run, on_data_problem)
     if test == "dwell":  # its amplitude checks over the dwell, as over a sweep of one frequency
         live = chans[ref][np.isfinite(chans[ref])]
-        f0, f1, rate, f_meas = (dwell_band(chans[ref], fs, float(row[DWELL]), path, run)
+        f0, f1, rate, f_meas = (dwell_band(chans[ref], fs, float(row[DWELL]), path, run, chans[RESPONSE])
                                 if live.size and live.min() < live.max() else (float(row[DWELL]),) * 2 + (1.0, np.nan))
         row = {**row, "f_start_hz": f0, "f_stop_hz": f1, "sweep_rate_hz_per_s": rate}
     else:

@@ -43,6 +43,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.ndimage import maximum_filter1d
 
+from ..spectral import drive_end
 from .frf import displacement_ratio
 
 __all__ = ["dwell_point", "dwell_mode", "TRANSIENT", "HELD"]
@@ -91,6 +92,10 @@ def dwell_point(response_g: NDArray, reference: NDArray, fs: float, f_hz: float,
     a = maximum_filter1d(d, max(int(round(fs / f_hz)), 1))  # the drive's envelope: its largest sample per period
     plateau = np.median(a[a > 0.5 * a.max()]) if a.max() > 0 else 0.0
     end = int(np.flatnonzero(d >= (1 - HELD) * plateau)[-1]) + 1 if plateau > 0 else ref.size  # its last peak
+    # a reference that stays live after the cut (a force gauge on a shaker left attached: the armature's reaction,
+    # at first above the dwell's force) holds its level past the cut; the response's steady state ends there
+    cut = drive_end(fs, ref - np.median(ref), np.nan_to_num(resp)) if plateau > 0 else None
+    end = min(end, cut) if cut is not None else end
     i0 = end // 2
     z_ref, z_resp = _lockin(ref[i0:end], fs, f_hz), _lockin(resp[i0:end], fs, f_hz)
     half = (end - i0) // 2

@@ -64,14 +64,13 @@ import pandas as pd
 from numpy.typing import NDArray
 from scipy import signal
 
+from ..spectral import DRIVE_OFF, HOLD, drive_end, plateau_end
 from ..units import G
 from ._decay_window import fit_window
 
 __all__ = ["decay_start", "ringdown_backbone", "ringdown_at", "COLUMNS", "DRIVE_OFF", "HOLD", "BAND", "ZETA_SE_MAX", "MISFIT_MAX", "SETTLE",
            "TAIL", "MIN_CYCLES", "GROW", "SPAN_MAX", "EXTEND", "SETTLE_MIXED"]
 
-DRIVE_OFF = 0.02  # a drive below this share of its largest value is off
-HOLD = 0.05  # without a drive: the decay starts where the envelope last lies within this share of its plateau
 BAND = 0.3  # band-pass half-width, relative to the mode's frequency
 ZETA_SE_MAX = 0.01  # a window is read while its decay rate's standard error is below this share of it
 TAIL = 0.1  # share of the record at its end whose band-passed rms is the noise (the decay has died out)
@@ -100,25 +99,21 @@ def decay_start(fs: float, response: NDArray, drive: NDArray | None = None) -> i
     Returns
     -------
     int
-        With a drive, one sample after the last at which |drive| exceeds DRIVE_OFF of its largest
-        value; without, the last sample at which the response's envelope (|analytic signal|, smoothed
-        over 50 ms, the record's first and last second left out) is within `HOLD` of its plateau (the
-        median of the envelope where it exceeds half its largest value): the end of a dwell's steady
-        state, or just after an impact's peak.
+        With a drive, `jointcal.spectral.drive_end`: one sample after the last at which |drive|
+        exceeds DRIVE_OFF of its largest value, unless the response has by then decayed below half
+        its plateau (a reference that stays live after the cut: a force gauge on a shaker left
+        attached). Else, and without a drive, `jointcal.spectral.plateau_end`: the last sample at
+        which the response's envelope (|analytic signal|, smoothed over 50 ms, the record's first
+        and last second left out) is within `HOLD` of its plateau (the median of the envelope where
+        it exceeds half its largest value): the end of a dwell's steady state, or just after an
+        impact's peak.
     """
     if drive is not None:
-        d = np.abs(np.nan_to_num(np.asarray(drive, float)))
-        on = np.flatnonzero(d > DRIVE_OFF * d.max()) if d.max() > 0 else np.empty(0, int)
-        if on.size == 0:
+        end = drive_end(fs, drive, response)
+        if end is None:
             raise ValueError("the drive channel is zero throughout: no drive was cut off; give the decay's start.")
-        end = on[-1] + 1
     else:
-        env = np.abs(signal.hilbert(np.nan_to_num(np.asarray(response, float))))
-        env = np.convolve(env, np.ones(max(1, int(0.05 * fs))) / max(1, int(0.05 * fs)), "same")
-        edge = min(int(fs), env.size // 8)  # the band-pass filter's and the transform's own edges
-        core = env[edge:env.size - edge]
-        plateau = np.median(core[core >= 0.5 * core.max()])  # a dwell's steady level (its start may overshoot)
-        end = edge + int(np.flatnonzero(core >= (1 - HOLD) * plateau)[-1])
+        end = plateau_end(fs, response)[2]
     if end >= len(response) - int(fs):
         raise ValueError("the drive (or the response's steady state) lasts until the record's last second: there is "
                          "no free decay to read; record at least a few seconds after the drive is cut off.")

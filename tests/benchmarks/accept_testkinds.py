@@ -1,0 +1,157 @@
+"""Acceptance of the ring-down and dwell read-outs on the virtual lab (issue 31): one truth, three kinds of test.
+
+Run:  python tests/benchmarks/accept_testkinds.py [--seeds 1,2,3] [--out FILE]
+
+For each rig -- the jointed beam of `tests/_support/rigs.py` (100 Hz, its Iwan joint, a second linear mode at
+230 Hz, on its small open-loop shaker) with a force and with a voltage reference, and the base-driven Ministack
+(`jointcal.synth.DEFAULT_SPEC`'s first assembly) -- one virtual campaign (`jointcal.synth.generate`: the exact-Iwan
+time simulation, the shaker, the DAQ, 2% noise on the beam, 0.1% on the Ministack as in tests/synth/test_steady.py)
+holds a ring-down cut off from a dwell at the top level's resonance, five dwells around the middle level's
+resonance (each with its own ring-down after the cut), and slow sweeps (eta 0.5) at three levels. Each run is
+read by the modal stage's functions (`campaign_modal`, `backbone_table`, `measure_run`), every point set beside
+the rig's truth at its own amplitude: the structure's first-harmonic balance (force: response / force is the
+structure alone; base: the Ministack's) or the coupled rig's pole (voltage: response / voltage holds the shaker).
+
+Printed per rig and seed: the ring-downs' decades and largest |f| and |zeta| errors; the dwells' phase
+resonance; the sweeps'; and the kinds on one backbone: each sweep's and dwell level's frequency against the
+ring-downs' at its amplitude (a line in log q through the windows within a factor `NEAR` of it, three or more).
+
+Acceptance (issue 31): ring-down f within 0.1%, zeta within 3% over >= 1.5 decades; dwells within 0.05% / 2%;
+the kinds on one backbone within 0.1%.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+HERE = Path(__file__).parents[2]
+sys.path.insert(0, str(HERE))
+from jointcal.io import ingest_campaign, read_run, test_kind  # noqa: E402
+from jointcal.measure.envelopes import envelopes, meta_dict  # noqa: E402
+from jointcal.measure.campaign import campaign_modal  # noqa: E402
+from jointcal.measure.testkinds import backbone_table  # noqa: E402
+from jointcal.models import harmonic_balance  # noqa: E402
+from jointcal.synth import DEFAULT_SPEC, generate  # noqa: E402
+from jointcal.synth.rig_truth import rig_pole  # noqa: E402
+from jointcal.units import G  # noqa: E402
+from tests._support import rigs  # noqa: E402
+
+FIRST = DEFAULT_SPEC["assemblies"]["first"]
+MINI = (FIRST["Fs"], FIRST["KT"], FIRST["chi"], FIRST["beta"], FIRST["k"], DEFAULT_SPEC["slug_weight_lbf"] / G,
+        FIRST["zeta_v"])
+
+
+def _beam_spec(ref: str, seed: int) -> tuple[dict, callable]:
+    levels = rigs.levels_V()
+    f_top, z_top = rigs.truth_curve(ref, rigs.Q_TARGETS[2])
+    f_mid, z_mid = rigs.truth_curve(ref, rigs.Q_TARGETS[1])
+    rate = 0.5 * (f_mid * z_mid) ** 2
+    spec = {"seed": seed, "sample_rate_hz": 2048.0, "measurement": {"noise_fraction": 0.02},
+            "sweep": {"f_start_hz": 0.7 * f_mid, "f_stop_hz": 1.3 * f_mid, "rate_hz_per_s": rate,
+                      "ramp_s": min(0.05, 0.02 * 0.6 * f_mid / rate), "tail_s": 1.5},
+            "series": [{"level_V": v, "directions": ["up"]} for v in levels]
+            + [{"level_V": levels[2], "test": "ringdown", "dwell_hz": [round(f_top, 3)], "dwell_s": 1.5,
+                "decay_s": 2.5},
+               {"level_V": levels[1], "test": "dwell", "dwell_s": 1.5, "decay_s": 2.5,
+                "dwell_hz": [round(f_mid * (1 + k * z_mid), 3) for k in (-1.0, -0.5, 0.0, 0.5, 1.0)]}],
+            "assemblies": {"beam": rigs.JOINTED_BEAM},
+            "rig": {"reference": ref, "shaker": rigs.SMALL_SHAKER, "second_mode": rigs.SECOND_MODE}}
+    return spec, lambda q: tuple(np.array([rigs.truth_curve(ref, v) for v in np.atleast_1d(q)]).T)
+
+
+def _ministack_spec(seed: int) -> tuple[dict, callable]:
+    f_res = harmonic_balance(np.array([1e-4]), *MINI)[0][0]
+    spec = {"seed": seed, "assemblies": {"first": FIRST},
+            "series": [{"level_g": lev, "directions": ["up"]} for lev in (1.0, 2.0, 5.0)]
+            + [{"level_g": 5.0, "test": "ringdown", "dwell_hz": [2180.0], "dwell_s": 0.3, "decay_s": 1.2},
+               {"level_g": 2.0, "test": "dwell", "dwell_hz": [2140.0, 2160.0, 2180.0, 2200.0, 2220.0],
+                "dwell_s": 0.4, "decay_s": 1.2}],
+            "measurement": {"noise_fraction": 1e-3, "dc_offset_g": 0.0}}
+    del f_res
+    return spec, lambda q: harmonic_balance(np.asarray(q, float), *MINI)
+
+
+NEAR = 1.5  # ring-down windows within this factor of a point's amplitude give the ring-downs' f there
+
+
+def case(name: str, spec: dict, truth, folder: Path) -> dict:
+    generate(spec, folder / "campaign", folder / "truth.json")
+    runs = ingest_campaign(folder / "campaign")
+
+    def load(row):
+        record = read_run(folder / "campaign" / row["file"], row)
+        if test_kind(row) != "sweep":
+            return None, {}, record
+        env, meta = envelopes(record, row)
+        return env, {**meta_dict(meta), "error": ""}, record
+
+    points: list = []
+    rows, _, _ = campaign_modal(runs, load, {}, points=points)
+    table = pd.DataFrame(rows)
+    bb = backbone_table(table, points)
+    f_t, z_t = truth(bb["q_in"].to_numpy())
+    bb = bb.assign(df=bb["f_hz"] / f_t - 1, dz=bb["zeta"] / z_t - 1)
+    rd = bb[bb["test"] == "ringdown"]
+    dec = rd.groupby("run_id")["q_in"].agg(lambda q: np.log10(q.max() / q.min()))
+    own = set(table.loc[table["test"] == "ringdown", "run_id"])  # the ring-down runs (the others: dwells' decays)
+    out = {"rig": name, "decays": int(dec.size), "rd_run_decades": float(dec[dec.index.isin(own)].min()),
+           "dwell_decay_decades": f"{dec[~dec.index.isin(own)].min():.2g}-{dec[~dec.index.isin(own)].max():.2g}",
+           "rd_f_max_pct": 100 * float(rd["df"].abs().max()), "rd_z_max_pct": 100 * float(rd["dz"].abs().max())}
+    dw = table[table["test"] == "dwell"]
+    out["dwell_flags"] = ";".join(sorted(set(";".join(dw["flags"].fillna("")).split(";")) - {""}))
+    dw = (dw.dropna(subset=["q_dwell_quad_in"]).drop_duplicates("q_dwell_quad_in") if "q_dwell_quad_in" in dw
+          else dw[:0])
+    if len(dw):
+        f_q, z_q = truth(dw["q_dwell_quad_in"].to_numpy())
+        out["dwell_f_pct"] = 100 * float(np.abs(dw["f_dwell_quad_hz"].to_numpy() / f_q - 1).max())
+        out["dwell_z_pct"] = 100 * float(np.abs(dw["zeta_dwell_quad"].to_numpy() / z_q - 1).max())
+    sw = bb[bb["test"] == "sweep"]
+    out["sweep_f_max_pct"] = 100 * float(sw["df"].abs().max()) if len(sw) else np.nan
+    out["sweep_z_max_pct"] = 100 * float(sw["dz"].abs().max()) if len(sw) else np.nan
+    # one backbone: each sweep's and each level's dwells' point against the ring-downs' windows at its amplitude
+    worst = np.nan
+    pts = pd.concat([sw[["q_in", "f_hz"]], pd.DataFrame({"q_in": dw["q_dwell_quad_in"], "f_hz": dw["f_dwell_quad_hz"]})
+                     if len(dw) else sw[:0][["q_in", "f_hz"]]])
+    for q, f in zip(pts["q_in"], pts["f_hz"]):
+        near = rd[(rd["q_in"] > q / NEAR) & (rd["q_in"] < q * NEAR)]
+        if len(near) >= 3:
+            c = np.polyfit(np.log(near["q_in"]), near["f_hz"], 1)
+            worst = np.nanmax([worst, abs(f / np.polyval(c, np.log(q)) - 1)])
+    out["one_backbone_f_pct"] = 100 * worst
+    if name == "beam force":  # the shaker stays on after the cut: the decay is the coupled rig's
+        model, sh, second = rigs.rig()
+        f_r = np.array([rig_pole(model, sh, v, second)[0] for v in rd["q_in"]])
+        out["rd_vs_rig_pole_f_pct"] = 100 * float(np.abs(rd["f_hz"].to_numpy() / f_r - 1).max())
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--seeds", default="1")
+    ap.add_argument("--out", default=None)
+    args = ap.parse_args()
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for seed in map(int, args.seeds.split(",")):
+            for name, (spec, truth) in (("beam force", _beam_spec("force", seed)),
+                                        ("beam voltage", _beam_spec("voltage", seed)),
+                                        ("ministack base", _ministack_spec(seed))):
+                r = case(name, spec, truth, Path(tmp) / f"{name.replace(' ', '_')}_{seed}")
+                r["seed"] = seed
+                rows.append(r)
+                print(json.dumps(r), flush=True)
+    t = pd.DataFrame(rows)
+    text = t.to_string(index=False, float_format=lambda v: f"{v:.3g}")
+    print(text)
+    if args.out:
+        Path(args.out).write_text(text + "\n")
+
+
+if __name__ == "__main__":
+    main()
