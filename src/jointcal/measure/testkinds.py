@@ -34,6 +34,7 @@ __all__ = ["other_kinds_modal", "backbone_table", "read_test_run", "BACKBONE_COL
 
 BACKBONE_COLUMNS = ["run_id", "mode", "test", "q_in", "f_hz", "zeta"]
 MIN_DECAY_S = 1.0  # a dwell's record this long after the cut holds a ring-down to read (as decay_start asks)
+LIVE = 0.1  # a force reference above this share of its level before the cut over the decay: the shaker stays on
 NEAR = 0.1  # relative distance within which two frequencies are one mode
 IDENTITY = ("run_id", "assembly", "sequence", "direction")
 
@@ -49,6 +50,15 @@ def _peak_hz(x: np.ndarray, fs: float, lo: float = 0.5, decay: bool = False) -> 
         noise = np.median(a[-max(a.size // 10, 1):])
         x = x[:max(int(np.flatnonzero(a > 20 * noise)[-1]) + 1 if (a > 20 * noise).any() else a.size, 64)]
     return peak_frequency(x, fs, pad=8, window=not decay, lo=lo)
+
+
+def _live_after_cut(ref: np.ndarray, start: int, fs: float) -> float:
+    """The reference's rms over the decay's first `MIN_DECAY_S` over its rms over the drive's last second."""
+    x = ref - np.median(ref)
+    n = int(MIN_DECAY_S * fs)
+    before, after = x[max(start - n, 0):start], x[start:start + n]
+    rms = lambda v: float(np.sqrt(np.mean(v**2))) if v.size else 0.0  # noqa: E731
+    return rms(after) / rms(before) if rms(before) > 0 else 0.0
 
 
 def _decay(resp: np.ndarray, ref: np.ndarray, fs: float) -> int | None:
@@ -94,8 +104,10 @@ def read_test_run(row: dict, record: pd.DataFrame, kind: str, mode_hz=None) -> d
         f = _peak_hz(resp, fs)
     if mode_hz is not None:
         f = min((float(v) for v in np.atleast_1d(mode_hz)), key=lambda v: abs(v - f))
-    out = {"row": row, "f_guess": f, "start": start, "windows": None, "point": None, "notes": []}
-    if start is not None:
+    out = {"row": row, "f_guess": f, "start": start, "windows": None, "point": None, "notes": [], "flags": []}
+    if start is not None and kind == "force" and _live_after_cut(ref, start, fs) > LIVE:
+        out["flags"].append("shaker_on")  # the decay is the structure's and the shaker's together: not read
+    elif start is not None:
         out["windows"] = ringdown_backbone(resp, fs, f, start=start)
     if row.get("test") == "dwell":
         out["point"] = dwell_point(resp, ref, fs, float(row[DWELL]), kind)
@@ -178,7 +190,7 @@ def other_kinds_modal(rows: list[dict], records: dict, kind: str, swept: dict[st
         if row.get("test") == "dwell" and np.isfinite(r["dwell"]["f_hz"]):
             d, p = r["dwell"], r["point"]
             fit = d["fit"]
-            flags += p["flags"] + fit["flags"]
+            flags += r["flags"] + p["flags"] + fit["flags"]
             points.append({"run_id": rid, "mode": r["mode"], "test": "dwell", **{k: d[k] for k in
                                                                                  ("q_in", "f_hz", "zeta")}})
             out.update(f_res_hz=d["f_hz"], zeta_res=d["zeta"], q_in=d["q_in"], f_res_method="dwell",
@@ -191,7 +203,8 @@ def other_kinds_modal(rows: list[dict], records: dict, kind: str, swept: dict[st
             top = w.loc[w["q_in"].idxmax()]
             out.update(f_res_hz=top["f_hz"], zeta_res=top["zeta"], q_in=top["q_in"], f_res_method="ringdown")
         else:
-            flags += (r["dwell"]["fit"]["flags"] if r.get("dwell") else ["no_decay"]) + [UNUSABLE]
+            flags += r["flags"] + (r["dwell"]["fit"]["flags"] if r.get("dwell") else
+                                   [] if r["flags"] else ["no_decay"]) + [UNUSABLE]
         if w is not None and len(w):
             out["ringdown_windows"] = len(w)
             out["ringdown_decades"] = float(np.log10(w["q_in"].max() / w["q_in"].min()))
