@@ -245,3 +245,28 @@ def test_rig_with_two_jointed_modes_balances_the_coil_s_work_with_each_joint_s_c
     D = [20 * dissipation(np.ptp(z[last]) / 2, p.Fs, p.KT, p.chi, p.beta) for z, p in zip(Z, (j1, j2))]
     assert D[0] > 0.05 * coil and D[1] > 0.2 * coil
     assert viscous + D[0] + D[1] == pytest.approx(coil, rel=1e-3)
+
+
+def test_the_pole_of_each_of_two_jointed_modes_is_the_stuck_rig_s_at_low_amplitude_and_rig_pole_with_a_linear_one():
+    """`rig_mode_pole`: at a vanishing amplitude both joints are stuck and the two poles are the eigenvalues of
+    the 5-state matrix (independent paths: polynomial roots, a 3x3 solve); with a linear second mode the
+    jointed mode's pole is `rig_pole` at the amplitude of x in it; each mode softens and damps with its own
+    amplitude, and the other joint moves by its share of the mode shape."""
+    from jointcal.synth.rig_truth import rig_mode_pole
+    from jointcal.synth.shaker import rig_joint_matrices
+
+    j1, j2 = IwanParams(4.0, 204.0, -0.5, 0.1), IwanParams(4.0, 1079.0, -0.5, 0.1)
+    model = MinistackModel(m=1 / G, k=818.0, zeta_v=0.008, iwan=j1)
+    second = StructureMode(f_hz=np.sqrt(5406 * G) / (2 * np.pi), zeta=0.006, weight_lbf=1.0, iwan=j2)
+    sh = Shaker(**SHAKER)
+    eig = np.linalg.eigvals(rig_joint_matrices(model, sh, second)[0])
+    eig = sorted(eig[eig.imag > 0], key=abs)
+    for mode, lam in zip((1, 2), eig):
+        f, z, qx, qy = rig_mode_pole(model, sh, second, 1e-16, mode)
+        assert f == pytest.approx(abs(lam) / (2 * np.pi), rel=1e-7) and z == pytest.approx(-lam.real / abs(lam), rel=1e-5)
+        f3, z3, qx3, qy3 = rig_mode_pole(model, sh, second, 3e-3, mode)
+        assert f3 < f * 0.99 and z3 > 1.2 * z  # its own joint slips
+        assert (qy3 / qx3 < 0.05) if mode == 1 else (qx3 / qy3 < 0.2)  # the other moves by its share
+    linear = StructureMode(f_hz=230.0, zeta=0.01, weight_lbf=0.5)
+    f, z, qx, _ = rig_mode_pole(model, sh, linear, 3e-3, 1)
+    assert (f, z) == pytest.approx(rig_pole(model, sh, qx, linear), rel=1e-12)
