@@ -219,7 +219,7 @@ def test_rig_with_two_jointed_modes_balances_the_coil_s_work_with_each_joint_s_c
     dissipation D(q) at its own amplitude (`jointcal.models.dissipation`), to 0.1% (measured 1.3e-4; each
     joint holds 9% and 38% of the total, so a lost or shared turning point would show)."""
     from jointcal.models import dissipation
-    from jointcal.models.simulate import integrate_joints
+    from jointcal.models.joints import integrate_joints
     from jointcal.synth.shaker import rig_joint_matrices
 
     j1, j2 = IwanParams(4.0, 204.0, -0.5, 0.1), IwanParams(4.0, 1079.0, -0.5, 0.1)

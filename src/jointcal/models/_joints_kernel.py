@@ -1,5 +1,5 @@
 """Numba kernel of the swept-sine integrator with several exact Iwan joints (private; see
-`jointcal.models.simulate.integrate_joints`).
+`jointcal.models.joints.integrate_joints`).
 
 The scheme of `jointcal.models._integrator.run` (exact propagation of the stuck-joint linear
 system, cubic Hermite input and remainders, one predict-evaluate-correct per step, reversals

@@ -6,8 +6,7 @@ The joint force is the exact Iwan hysteresis (turning-point rules, no sliders); 
 linear structure is propagated exactly (zero natural-frequency error at any step);
 see `jointcal.models._integrator` for the scheme. `integrate` runs the same scheme on any
 linear system with one joint DOF (e.g. a structure coupled to a shaker,
-`jointcal.synth.shaker`), `integrate_joints` on one with an exact Iwan joint on each of
-several DOFs (two jointed modes coupled through a shaker).
+`jointcal.synth.shaker`).
 """
 from __future__ import annotations
 
@@ -20,14 +19,14 @@ from scipy.signal import resample_poly
 
 from collections.abc import Sequence
 
-from . import _integrator, _joints_kernel
+from . import _integrator
 from ..units import G
 from ._masing import kernel_constants
 from .elements import CONTACT_SPRING, Element, element_table
 from .iwan import IwanParams, derived
 from .structure import MinistackModel, Neighbour, StateSpace, state_space
 
-__all__ = ["SimResult", "simulate", "integrate", "integrate_joints", "hermite_propagator", "fractional_delay", "substeps",
+__all__ = ["SimResult", "simulate", "integrate", "hermite_propagator", "fractional_delay", "substeps",
            "band_limited"]
 
 
@@ -259,63 +258,3 @@ def integrate(ss: StateSpace, u: NDArray, fs: float, n_sub: int, *, iwan: IwanPa
     z = np.empty_like(u)
     _integrator.run(u, _integrator.rate(u, fs), maps, outs, joint, sl, element_table(elements), Y, z)
     return Y, z
-
-
-def integrate_joints(A: NDArray, bu: NDArray, BF: NDArray, LZ: NDArray, LV: NDArray, u: NDArray, fs: float,
-                     n_sub: int, joints: Sequence[IwanParams | None],
-                     outputs: Sequence[tuple[NDArray, float, NDArray]]) -> tuple[NDArray, NDArray]:
-    """Integrate x' = A x + bu u + BF r from rest, r_j the remainder of an exact Iwan joint on z_j = LZ[j].x.
-
-    The scheme of `integrate` (`jointcal.models._joints_kernel`), each joint with its own
-    turning-point state: r_j = F_iwan,j(z_j) - KT_j z_j, A holding every joint stuck. With one
-    joint, or with all joints but one None, the result is `integrate`'s bit for bit.
-
-    Parameters
-    ----------
-    A : ndarray, shape (n, n)
-        The linear system with every joint stuck.
-    bu : ndarray, shape (n,)
-        Input map (the units of u: V for a drive voltage).
-    BF : ndarray, shape (n, J)
-        Map of each joint's remainder (lbf).
-    LZ, LV : ndarray, shape (J, n)
-        Joint displacements z = LZ.x (in) and rates z' = LV.x (in/s).
-    u : ndarray, shape (N,)
-        Input at the samples.
-    fs : float
-        Sample rate of u, Hz.
-    n_sub : int
-        Integration substeps per sample.
-    joints : sequence of IwanParams or None, length J
-        Joint j's parameters; None: no joint on that DOF (r_j = 0).
-    outputs : sequence of (c (n,), du, df (J,))
-        Output channels y = c.x + du u + df.r.
-
-    Returns
-    -------
-    Y : ndarray, shape (n_outputs, N)
-        The outputs at the samples.
-    Z : ndarray, shape (J, N)
-        The joint displacements at the samples, in.
-    """
-    u = np.ascontiguousarray(u, dtype=float)
-    BF, LZ, LV = (np.atleast_2d(np.asarray(a, dtype=float)) for a in (BF, LZ, LV))
-    J = len(joints)
-    if BF.shape != (A.shape[0], J) or LZ.shape != (J, A.shape[0]) or LV.shape != LZ.shape:
-        raise ValueError(f"integrate_joints: BF {BF.shape}, LZ {LZ.shape}, LV {LV.shape} do not fit "
-                         f"{A.shape[0]} states and {J} joints.")
-    h = 1.0 / fs / n_sub
-    Phi, Gu = hermite_propagator(A, bu, h)
-    Gf = np.ascontiguousarray(np.stack([hermite_propagator(A, BF[:, j], h)[1] for j in range(J)]))
-    Gsub, Wub = _substep_maps(Gu, n_sub)
-    maps = (1.0 / fs, Gsub, Wub, np.ascontiguousarray(Phi), Gf, np.ascontiguousarray(LZ), np.ascontiguousarray(LV))
-    outs = (np.ascontiguousarray(np.array([np.asarray(c, float) for c, _, _ in outputs])),
-            np.array([float(d) for _, d, _ in outputs]),
-            np.ascontiguousarray(np.array([np.broadcast_to(np.asarray(d, float), (J,)) for _, _, d in outputs])))
-    cols = [_joint(p, None)[0] for p in joints]
-    kinds = (np.array([c[0] for c in cols], dtype=np.int64),
-             *(np.array([c[i] for c in cols], dtype=float) for i in range(1, 6)))
-    Y = np.empty((len(outputs), u.size))
-    Z = np.empty((J, u.size))
-    _joints_kernel.run_joints(u, _integrator.rate(u, fs), maps, outs, kinds, Y, Z)
-    return Y, Z

@@ -32,7 +32,7 @@ A second mode may carry its own Iwan joint (`StructureMode.iwan`: m_2 y'' + c_2 
 + r_nl,2 = F, k_2 the stuck stiffness, r_nl,2 = F_iwan,2(y) - KT_2 y): two jointed modes the
 coil's back-EMF and the armature couple, so they are not integrated apart; the 5-state
 system is then integrated with a joint on each of x and y
-(`jointcal.models.simulate.integrate_joints`, the same exact Iwan force law and scheme).
+(`jointcal.models.joints.integrate_joints`, the same exact Iwan force law and scheme).
 
 The rig's truth at a drive level (what its FRFs show) is `jointcal.synth.rig_truth`.
 """
@@ -45,7 +45,8 @@ from numpy.typing import NDArray
 
 from ..models import IwanParams, MinistackModel
 from ..units import G, INCH_M, LBF_N
-from ..models.simulate import band_limited, fractional_delay, integrate, integrate_joints
+from ..models.joints import integrate_joints
+from ..models.simulate import band_limited, fractional_delay, integrate
 from ..models.structure import StateSpace
 
 __all__ = ["Shaker", "StructureMode", "BL_E_PER_BL", "rig_matrices", "rig_joint_matrices", "simulate_rig"]
