@@ -6,6 +6,10 @@ force shows) at the steady-state amplitude at its own phase resonance, and the r
 pole (what H1 of response / voltage shows) at the steady-state amplitude at the rig's
 resonance. For a nonlinear joint the two amplitudes differ: the rig's resonance lies
 below the structure's (armature mass), and at the structure's the force drops out.
+
+With a second mode that carries its own joint (`StructureMode.iwan`), each mode's truth is
+`rig_mode_pole`: the coupled rig's pole of that mode, each joint's first-harmonic stiffness
+and loss taken at the amplitude its own coordinate has in that mode's shape.
 """
 from __future__ import annotations
 
@@ -17,8 +21,8 @@ from ..models.iwan import derived
 from .non_masing import equivalent, share_of
 from .shaker import BL_E_PER_BL, Shaker, StructureMode, _structure
 
-__all__ = ["peak_amplitude", "structure_equivalent", "rig_pole", "steady_amplitude", "structure_resonance_amplitude",
-           "rig_truth"]
+__all__ = ["peak_amplitude", "structure_equivalent", "rig_pole", "rig_mode_pole", "steady_amplitude",
+           "structure_resonance_amplitude", "rig_truth"]
 
 
 def structure_equivalent(model: MinistackModel, q: float) -> tuple[float, float]:
@@ -45,6 +49,8 @@ def _structure_terms(model: MinistackModel, q: float) -> tuple[float, float, flo
     not depend on frequency), so S(w) = k_df - m w^2 + i (w c + h).
     """
     ks, c, m = _structure(model)
+    if q <= 0.0:  # the joint stuck
+        return ks, c, 0.0
     f, z = structure_equivalent(model, q)
     w = 2 * np.pi * f
     k_df = m * w**2
@@ -53,12 +59,19 @@ def _structure_terms(model: MinistackModel, q: float) -> tuple[float, float, flo
     return k_df, c, h
 
 
+def _second_terms(second: StructureMode, q2: float) -> tuple[float, float, float]:
+    """The second mode's (k_df, c, h) as `_structure_terms`, its joint at amplitude q2 (in; stuck at 0)."""
+    if second.iwan is None or q2 <= 0.0:
+        return second.k, second.c, 0.0
+    return _structure_terms(second.model(), q2)
+
+
 def _electrical(shaker: Shaker):
     return (shaker.bl_lbf_per_A, shaker.bl_lbf_per_A * BL_E_PER_BL, shaker.coil_mH * 1e-3, shaker.coil_ohm)
 
 
 def _x_over_v(model: MinistackModel, shaker: Shaker, q: float, w: NDArray,
-              second: StructureMode | None = None) -> NDArray:
+              second: StructureMode | None = None, q2: float = 0.0) -> NDArray:
     """The equivalent-linear rig's FRF x / V (in/V) at amplitude q and frequencies w (rad/s).
 
     With S_1 = k_df - m w^2 + i (w c + h) the jointed mode, S_2 the second mode's dynamic
@@ -69,18 +82,23 @@ def _x_over_v(model: MinistackModel, shaker: Shaker, q: float, w: NDArray,
     Bl, Ble, L, R = _electrical(shaker)
     s1 = k_df - model.m * w**2 + 1j * (w * c + h)
     sa = shaker.k_s - shaker.m_a * w**2 + 1j * w * shaker.c_s
-    ratio = 1.0 if second is None else 1.0 + s1 / (second.k - second.m * w**2 + 1j * w * second.c)
+    if second is None:
+        ratio = 1.0
+    else:
+        k2, c2, h2 = _second_terms(second, q2)
+        ratio = 1.0 + s1 / (k2 - second.m * w**2 + 1j * (w * c2 + h2))
     return 1.0 / ((R + 1j * w * L) * (sa * ratio + s1) / Bl + 1j * w * Ble * ratio)
 
 
 def _rig_poly(model: MinistackModel, shaker: Shaker, q: float, w_eval: float | None = None,
-              second: StructureMode | None = None):
+              second: StructureMode | None = None, q2: float = 0.0):
     """Characteristic polynomial (in s) of the equivalent-linear rig at amplitude q, and Bl.
 
     (R + L s)(S_a (S_2 + S_1) + S_1 S_2) + Bl Bl_e s (S_2 + S_1) (S_2 = 1 without a second
     mode: (R + L s)(S_a + S_1) + Bl Bl_e s), S_j = m_j s^2 + c_j s + k_j. The joint's
     hysteretic loss h enters as the viscous h / w_eval (exact at w_eval, default the
-    structure's own frequency; `rig_pole` iterates it to the pole's).
+    structure's own frequency; `rig_pole` iterates it to the pole's); a jointed second mode's
+    likewise, its joint at amplitude q2 (in).
     """
     k_df, c, h = _structure_terms(model, q)
     w_eval = np.sqrt(k_df / model.m) if w_eval is None else w_eval
@@ -90,7 +108,8 @@ def _rig_poly(model: MinistackModel, shaker: Shaker, q: float, w_eval: float | N
     if second is None:
         mech, emf = np.polyadd(sa, s1), np.array([Bl * Ble, 0.0])
     else:
-        s2 = np.array([second.m, second.c, second.k])
+        k2, c2, h2 = _second_terms(second, q2)
+        s2 = np.array([second.m, c2 + h2 / w_eval, k2])
         both = np.polyadd(s2, s1)
         mech = np.polyadd(np.polymul(sa, both), np.polymul(s1, s2))
         emf = np.polymul([Bl * Ble, 0.0], both)
@@ -112,6 +131,59 @@ def rig_pole(model: MinistackModel, shaker: Shaker, q: float,
         lam = r[np.argmin(np.abs(np.abs(r) - w))]
         w = abs(lam)
     return float(abs(lam) / (2 * np.pi)), float(-lam.real / abs(lam))
+
+
+def rig_mode_pole(model: MinistackModel, shaker: Shaker, second: StructureMode, q: float,
+                  mode: int = 1) -> tuple[float, float, float, float]:
+    """The rig's pole of one of its two structural modes at the amplitude q (in) it has at the driving point.
+
+    The equivalent-linear rig of `_rig_poly` with each joint at the amplitude its own coordinate
+    has in that mode's shape: at the pole w the structure's two modes carry one force, so
+    y / x = S_1 / S_2 and the driving point moves by u = x + y (a fixed point, iterated to < 1e-12).
+
+    Parameters
+    ----------
+    model : MinistackModel
+        The jointed mode (coordinate x).
+    shaker : Shaker
+    second : StructureMode
+        The second mode (coordinate y), linear or jointed.
+    q : float
+        The mode's displacement amplitude at the driving point, in: what a read-out's q_in is.
+    mode : {1, 2}
+        1: the pole of the jointed mode `model`; 2: the second mode's.
+
+    Returns
+    -------
+    f_hz, zeta, qx, qy : float
+        The pole's |lambda| / 2 pi (Hz) and -Re(lambda) / |lambda|, and the amplitudes (in) of
+        x and y in it.
+    """
+    if mode not in (1, 2):
+        raise ValueError(f"rig_mode_pole: mode must be 1 or 2, got {mode!r}.")
+    qx, qy = (q, 0.0) if mode == 1 else (0.0, q)
+    w = 2 * np.pi * (structure_equivalent(model, q)[0] if mode == 1 else
+                     structure_equivalent(second.model(), q)[0])
+    for _ in range(40):
+        for _ in range(4):
+            r = np.roots(_rig_poly(model, shaker, qx, w, second, qy)[0])
+            r = r[np.imag(r) > 0]
+            lam = r[np.argmin(np.abs(np.abs(r) - w))]
+            w = abs(lam)
+        k1, c1, h1 = _structure_terms(model, qx)
+        k2, c2, h2 = _second_terms(second, qy)
+        ratio = ((k1 - model.m * w**2 + 1j * (w * c1 + h1)) /
+                 (k2 - second.m * w**2 + 1j * (w * c2 + h2)))  # y / x
+        old = (qx, qy)
+        if mode == 1:
+            qx = q / abs(1.0 + ratio)
+            qy = qx * abs(ratio)
+        else:
+            qy = q / abs(1.0 + 1.0 / ratio)
+            qx = qy / abs(ratio)
+        if abs(qx - old[0]) <= 1e-12 * q and abs(qy - old[1]) <= 1e-12 * q:
+            break
+    return float(abs(lam) / (2 * np.pi)), float(-lam.real / abs(lam)), float(qx), float(qy)
 
 
 def _self_consistent(model: MinistackModel, amp, iterations: int = 60) -> float:
