@@ -37,6 +37,7 @@ from ..measure.envelopes import ZETA_MIN
 from ..posterior.sampler import TAU_FACTOR
 from ..validate import ValidateSettings, model_from_best, validate_runs
 from .data import run_envelope, scale_arrays
+from .decay_stage import diagnose_decays
 from .fingerprints import fingerprints, outside_library, residual_map, verdicts
 from .fit import Objective, candidate, model_at, structure_scales
 from .floor import fast_floor
@@ -97,7 +98,8 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
              validate_settings: ValidateSettings = ValidateSettings(), envelopes_kw: dict | None = None,
              modal_kw: dict | None = None, metric_before: float | None = None,
              frames_before: Mapping[str, pd.DataFrame] | None = None, executor=None,
-             joint_starts: Sequence[Sequence[float]] = (), log: Callable[[str], None] | None = None) -> dict:
+             joint_starts: Sequence[Sequence[float]] = (), log: Callable[[str], None] | None = None,
+             backbone: pd.DataFrame | None = None) -> dict:
     """Diagnose one assembly; returns the diagnosis (diagnosis.json's content plus tables and models).
 
     Parameters
@@ -111,7 +113,9 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     assembly's runs (for the time-simulation revalidation); metric_before : the validation
     stage's E (recomputed when None); joint_starts : further joint parameter sets (6,) from
     which the final model is also refit (e.g. the GA's best individual in each other valley:
-    eq. 3.9 leaves the Fs-KT split flat, the envelopes may not).
+    eq. 3.9 leaves the Fs-KT split flat, the envelopes may not); backbone : backbone.csv's rows of the
+    assembly's runs: a campaign without sweep envelopes (ring-downs, dwells) is diagnosed from them
+    (`decay_stage.diagnose_decays`).
     """
     say = log or (lambda s: None)
     clock = _Clock()
@@ -122,6 +126,15 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     gain = drive_gain(modal[modal["assembly"] == assembly]) if level_column(modal.columns) != LEVEL["base"] else None
     if gain is not None:  # a force or voltage drives the mode through the campaign's modal constant
         rows = [{**r, "drive_gain": gain} for r in rows]
+    if backbone is not None and not any(r["run_id"] in envs for r in rows):  # ring-downs and dwells alone
+        mine = modal[modal["assembly"] == assembly]
+        peak = mine.set_index("run_id")["mode_peak_hz"] if "mode_peak_hz" in mine else pd.Series(dtype=float)
+        return diagnose_decays(assembly, backbone, mine, best, records,
+                               [{"mode_hz": peak.get(r["run_id"]), **r} for r in rows], space=space, scales=scales,
+                               settings=settings, validate_settings=validate_settings,
+                               vkw=dict(envelopes_kw=envelopes_kw, modal_kw=modal_kw, executor=executor),
+                               metric_before=metric_before, frames_before=frames_before, joint_starts=joint_starts,
+                               log=say)
     theta0 = np.array([best[p] for p in PARAMS], dtype=float)
     vkw = dict(settings=validate_settings, envelopes_kw=envelopes_kw, modal_kw=modal_kw, executor=executor)
     if scale is None or frames_before is None:  # as the validation stage does: the calibrated model in time

@@ -224,8 +224,9 @@ def rig_truth(model: MinistackModel, shaker: Shaker, volts: float, t: NDArray | 
     out = dict(q_ss_in=q_s, f_hb_hz=f, zeta_hb=z, q_rig_ss_in=q_r, f_rig_hz=fr, zeta_rig=zr)
     if x is not None:
         qs, qr = _reached(t, f_inst, x, f, z), _reached(t, f_inst, x, fr, zr)
-        f2, z2 = structure_equivalent(model, qs)
-        fr2, zr2 = rig_pole(model, shaker, qr, second)
+        none = (float("nan"), float("nan"))  # an amplitude not reached (a dwell off the resonance's band)
+        f2, z2 = structure_equivalent(model, qs) if np.isfinite(qs) else none
+        fr2, zr2 = rig_pole(model, shaker, qr, second) if np.isfinite(qr) else none
         fs = 1.0 / float(t[1] - t[0])
         out.update(q_reached_in=qs, f_hb_hz_reached=f2, zeta_hb_reached=z2, q_rig_reached_in=qr,
                    f_rig_hz_reached=fr2, zeta_rig_reached=zr2, q_peak_in=peak_amplitude(x, fs, f))
