@@ -32,8 +32,9 @@ NOISE = 0.005  # of each channel's RMS: at 2% the drive's noise after the cut st
 
 
 def ring_down_campaign(folder: Path, effect: str = "none", params: dict | None = None, *, seed: int = 1,
-                       noise: float = NOISE, levels: list[float] | None = None) -> Path:
-    """Generate and read the campaign into folder/campaign and folder/modal; returns folder/modal."""
+                       noise: float = NOISE, levels: list[float] | None = None, also: dict | None = None) -> Path:
+    """Generate and read the campaign into folder/campaign and folder/modal; returns folder/modal. also : a
+    second hidden effect ({name, params})."""
     f, _ = truth_curve("voltage", 3e-3)
     series = [{"level_V": v, "test": "ringdown", "dwell_hz": [round(f, 1)], "dwell_s": DWELL_S, "decay_s": DECAY_S}
               for v in (levels or levels_V())]
@@ -41,7 +42,7 @@ def ring_down_campaign(folder: Path, effect: str = "none", params: dict | None =
             "sweep": {"f_start_hz": 0.7 * f, "f_stop_hz": 1.3 * f, "rate_hz_per_s": 1.0, "ramp_s": 0.05,
                       "tail_s": 1.5},  # no sweep is run: the spec's sweep section is required
             "series": series, "assemblies": {"beam": JOINTED_BEAM},
-            "effect": {"name": effect, "params": params or {}},
+            "effect": {"name": effect, "params": params or {}, **({"also": also} if also else {})},
             "rig": {"reference": "voltage", "shaker": SMALL_SHAKER}}
     generate(spec, folder / "campaign", folder / "truth.json")
     runs = ingest_campaign(folder / "campaign")

@@ -11,13 +11,14 @@ import pytest
 
 from jointcal.calibrate.ga import GAOptions
 from jointcal.calibrate.space import PARAMS, ParamSpace
-from jointcal.discrepancy import DiscrepancySettings
+from jointcal.discrepancy import DiscrepancySettings, diagnosis_markdown
 from jointcal.discrepancy.decay_stage import NOT_SEEN, not_seen
 from jointcal.discrepancy.decays import DecayObjective, decay_folds, decay_runs
 from jointcal.discrepancy.fit import candidate
 from jointcal.effects import library
 from jointcal.models import IwanParams, MinistackModel
 from jointcal.models.free_decay import free_backbone
+from jointcal.report.discrepancy import decay_before_after_figure, decay_residual_figure
 from tests._support.decay_campaign import calibrate_and_diagnose, ring_down_campaign
 
 JOINT = dict(Fs=4.0, KT=204.0, chi=-0.5, beta=0.1, k=818.0, zeta_v=0.008)
@@ -85,8 +86,9 @@ def test_ring_downs_alone_name_the_hidden_effect(tmp_path, effect, params):
     high, E 14.3 -> 1.2; elastic_softening -> named, high, E 7.8 -> 1.1. About 12 s of CPU each (70-140 s of
     wall time on the loaded 2-core machine)."""
     ring_down_campaign(tmp_path, effect, params, seed=1)
-    d = calibrate_and_diagnose(tmp_path, DiscrepancySettings(ga_generations=10, posterior_steps=200),
-                               ga=GAOptions(population=80, offspring=80, generations=40))["diagnosis"]
+    res = calibrate_and_diagnose(tmp_path, DiscrepancySettings(ga_generations=10, posterior_steps=200),
+                                 ga=GAOptions(population=80, offspring=80, generations=40))
+    d = res["diagnosis"]
     truth = json.loads((tmp_path / "truth.json").read_text())["effect"]
     assert truth["name"] == effect and d["data"] == "decays"
     assert set(d["not_seen_by_decays"]) == {"channel_delay", "neighbour_mode"}
@@ -101,3 +103,8 @@ def test_ring_downs_alone_name_the_hidden_effect(tmp_path, effect, params):
         # per unit modal mass: the rig's mode (beam and armature, 1.05 lbf) for the cubic spring
         want = value / (1.05 / 386.089) if name == "k3" else value
         assert abs(got / want - 1) < 0.2, (got, want)
+    md = diagnosis_markdown(d)  # the words, and the figures of a ring-down campaign
+    assert "Not tried: `channel_delay`" in md and (effect in md if effect != "none" else "**No missing effect" in md)
+    decay_residual_figure(res["residuals"], d, tmp_path / "res.png")
+    decay_before_after_figure({}, res["validation_after"].frames, d, tmp_path / "ba.png")
+    assert (tmp_path / "res.png").stat().st_size > 1000 and (tmp_path / "ba.png").stat().st_size > 1000

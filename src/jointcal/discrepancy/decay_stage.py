@@ -86,9 +86,11 @@ def decay_floor(c, theta: np.ndarray, runs: Sequence[DecayRun], frames: Mapping[
             run = DecayRun(q[ok], f[ok], z[ok], np.full(ok.sum(), sf), np.full(ok.sum(), sz), own[0].row, own[0].level)
             pseudo.append(run)
             per[rid] = DecayObjective(c, [run]).E(theta)
+    what = ("its free-decay backbone against the time simulation of the same model's ring-downs, read by the same "
+            "estimator at the same windows")
     if not pseudo:
-        return {"E": None, "n_runs": 0, "per_run": {}}
-    return {"E": DecayObjective(c, pseudo).E(theta), "n_runs": len(pseudo), "per_run": per}
+        return {"E": None, "n_runs": 0, "per_run": {}, "what": what}
+    return {"E": DecayObjective(c, pseudo).E(theta), "n_runs": len(pseudo), "per_run": per, "what": what}
 
 
 def _scored_json(s, c, rec=None) -> dict:
