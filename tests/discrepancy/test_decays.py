@@ -108,3 +108,16 @@ def test_ring_downs_alone_name_the_hidden_effect(tmp_path, effect, params):
     decay_residual_figure(res["residuals"], d, tmp_path / "res.png")
     decay_before_after_figure({}, res["validation_after"].frames, d, tmp_path / "ba.png")
     assert (tmp_path / "res.png").stat().st_size > 1000 and (tmp_path / "ba.png").stat().st_size > 1000
+
+
+def test_a_levels_dwells_count_once_by_their_phase_resonance():
+    backbone, rows = _points(n=10)
+    dwells = [{"run_id": f"d{i}", "sequence": 4 + i, "level_V": 0.8, "test": "dwell", "dwell_hz": 95.0 + i,
+               "q_dwell_quad_in": 3e-3, "f_dwell_quad_hz": 96.2, "zeta_dwell_quad": 0.016} for i in range(3)]
+    own = backbone[backbone["run_id"] == "rd1"].assign(run_id="d1")  # the middle dwell's record rings down too
+    runs = decay_runs(pd.concat([backbone, own]), pd.DataFrame(rows + dwells), rows + dwells)
+    ids = [r.run_id for r in runs]
+    assert ids == ["rd0", "rd1", "rd2", "d0:phase_resonance", "d1"]  # the level's point once, d1's own windows
+    point = runs[3]
+    assert (point.q_in[0], point.f_hz[0], point.zeta[0]) == (3e-3, 96.2, 0.016) and point.level == 0.8
+    assert set(decay_folds(runs)) == {"0.1 V", "0.4 V", "0.8 V", "1.2 V"}
