@@ -45,6 +45,32 @@ def ring_down_campaign(folder: Path, effect: str = "none", params: dict | None =
             "effect": {"name": effect, "params": params or {}, **({"also": also} if also else {})},
             "rig": {"reference": "voltage", "shaker": SMALL_SHAKER}}
     generate(spec, folder / "campaign", folder / "truth.json")
+    return _read(folder)
+
+
+def ministack_ring_downs(folder: Path, effect: str = "none", params: dict | None = None, *, seed: int = 5,
+                        levels: tuple = (0.3, 1.0, 3.0, 10.0)) -> Path:
+    """The base-driven Ministack's first assembly (Table 3.2) rung down from a dwell at each level's resonance (g),
+    as tests/calibrate/test_readouts.py makes them (0.1% noise, no DC offset), the effect hidden; folder/modal."""
+    from jointcal.models import resonance_amplitude
+    from jointcal.synth import DEFAULT_SPEC
+    from jointcal.units import G
+
+    first = DEFAULT_SPEC["assemblies"]["first"]
+    m = DEFAULT_SPEC["slug_weight_lbf"] / G
+    series = []
+    for lv in levels:
+        f = float(resonance_amplitude(lv, *(first[p] for p in ("Fs", "KT", "chi", "beta", "k")), m,
+                                      first["zeta_v"])[1])
+        series.append({"level_g": lv, "test": "ringdown", "dwell_hz": [round(f, 1)], "dwell_s": 0.2, "decay_s": 1.2})
+    spec = {**DEFAULT_SPEC, "seed": seed, "assemblies": {"first": first}, "series": series,
+            "measurement": {**DEFAULT_SPEC["measurement"], "noise_fraction": 1e-3, "dc_offset_g": 0.0},
+            "effect": {"name": effect, "params": params or {}}}
+    generate(spec, folder / "campaign", folder / "truth.json")
+    return _read(folder)
+
+
+def _read(folder: Path) -> Path:
     runs = ingest_campaign(folder / "campaign")
     points: list = []
     rows, _, _ = campaign_modal(runs, lambda row: (None, {}, read_run(folder / "campaign" / row["file"], row)), {},
@@ -58,14 +84,15 @@ def ring_down_campaign(folder: Path, effect: str = "none", params: dict | None =
 
 
 def calibrate_and_diagnose(folder: Path, settings: DiscrepancySettings, *, ga: GAOptions | None = None,
-                           log=None) -> dict:
-    """Calibrate from the ring-downs (the modal kind; `ga` the GA's options) and diagnose; the diagnosis."""
+                           log=None, assembly: str = "beam") -> dict:
+    """Calibrate from the ring-downs (the model kind following the excitation; `ga` the GA's options) and
+    diagnose; the diagnosis."""
     modal = folder / "modal"
     cal = CalibrateSettings(model_kind="auto", **({"ga": ga} if ga is not None else {}))
-    run_calibration(modal / "modal_properties.csv", "beam", folder / "cal", cal, backbone_csv=modal / "backbone.csv")
+    run_calibration(modal / "modal_properties.csv", assembly, folder / "cal", cal, backbone_csv=modal / "backbone.csv")
     best = json.loads((folder / "cal" / "ga_best.json").read_text())
     rows = read_manifest(folder / "campaign" / "manifest.csv").to_dict("records")
     records = [read_run(folder / "campaign" / r["file"], r) for r in rows]
-    return diagnose("beam", {}, pd.read_csv(modal / "modal_properties.csv"), best, None, records, rows,
+    return diagnose(assembly, {}, pd.read_csv(modal / "modal_properties.csv"), best, None, records, rows,
                     space=cal.resolved(best).space, settings=settings, backbone=pd.read_csv(modal / "backbone.csv"),
                     joint_starts=valley_starts(pd.read_csv(folder / "cal" / "ga_history.csv"), best), log=log)

@@ -16,6 +16,10 @@
    runs) -> metric_before, metric_after. A 'none' that the time simulation contradicts
    (E above `rule.NONE_E` before and after) becomes 'unexplained'; a name the time
    simulation does not confirm (E not lower after) keeps confidence low.
+
+A campaign of ring-downs and dwells alone (no sweep) takes the same steps on its backbone points
+(`decay_stage.diagnose_decays`: each candidate's free-decay backbone, held-out runs, the same rule,
+recalibration and time-domain revalidation of the decays).
 """
 from __future__ import annotations
 
