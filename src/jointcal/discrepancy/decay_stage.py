@@ -1,7 +1,7 @@
 """The discrepancy stage for a campaign of ring-downs (and dwells): the same steps as the sweeps' (`stage`).
 
 0. Points and floor: the backbone points of every ring-down and each level's dwells (`decays.decay_runs`),
-   scaled by their own scatter; the fast model's floor F is its backbone of the calibrated model
+   scaled by the read-out's own standard errors (the ring-downs read again from their records, `read_again`); the fast model's floor F is its backbone of the calibrated model
    (`models.free_decay`) against that model's time simulation read by the same estimator at the same
    windows (the validation's frames: `jointcal.validate.decay`), in the same E.
 1. Candidates: the baseline and every library effect a decay can show. An effect whose parameters do not
@@ -25,7 +25,8 @@ import pandas as pd
 
 from ..calibrate.space import PARAMS, ParamSpace
 from ..effects import EFFECTS, effects_of
-from ..io import level_column
+from ..io import excitation_kind, level_column, test_kind
+from ..measure.testkinds import read_test_run
 from ..validate import ValidateSettings, model_from_best, validate_runs
 from .decays import DecayObjective, DecayRun, decay_folds, decay_runs
 from .fit import candidate, model_at
@@ -34,7 +35,7 @@ from .rule import CLAUSES, confirm, decide, needs_pairs, pair_names
 from .select import score_candidates
 from .settings import DiscrepancySettings
 
-__all__ = ["diagnose_decays", "decay_floor", "not_seen", "NOT_SEEN"]
+__all__ = ["diagnose_decays", "decay_floor", "not_seen", "read_again", "NOT_SEEN"]
 
 NOT_SEEN = ("its parameters do not change the free decay's backbone f(q), zeta(q) (a free decay has no phase "
             "against a drive, and the read-out band-passes the mode): it cannot be named from decays")
@@ -62,6 +63,22 @@ def not_seen(names: Sequence[str], space: ParamSpace, m: float, scales, runs: Se
             continue
         if np.allclose(f, f0, rtol=1e-12, atol=0) and np.allclose(z, z0, rtol=1e-12, atol=0):
             out[name] = NOT_SEEN
+    return out
+
+
+def read_again(records: Sequence[pd.DataFrame], rows: Sequence[Mapping]) -> dict[str, pd.DataFrame]:
+    """Each ring-down's windows read from its record as the modal stage and the validation read them
+    (`jointcal.measure.testkinds.read_test_run`), for the read-out's own standard errors; run_id -> windows."""
+    out = {}
+    for rec, row in zip(records, rows):
+        if test_kind(row) == "sweep":
+            continue
+        try:
+            w = read_test_run(dict(row), rec, excitation_kind(rec.columns), row.get("mode_hz"))["windows"]
+        except ValueError:  # a record the read-out refuses: the pooled scatter stands in
+            continue
+        if w is not None and len(w):
+            out[str(row["run_id"])] = w
     return out
 
 
@@ -137,7 +154,7 @@ def diagnose_decays(assembly: str, backbone: pd.DataFrame, modal: pd.DataFrame, 
     kind = str(best.get("model_kind", "ministack"))
     vkw = dict(vkw or {}, settings=validate_settings)
     runs = decay_runs(backbone, modal, rows, floor_db=validate_settings.floor_db,
-                      floor_deg=validate_settings.floor_deg)
+                      floor_deg=validate_settings.floor_deg, se=read_again(records, rows))
     if len({r.run_id for r in runs}) < 2:
         raise ValueError(f"assembly {assembly}: {len({r.run_id for r in runs})} run(s) with backbone points; the "
                          "discrepancy workflow needs at least two ring-downs (or levels of dwells) to score held-out "

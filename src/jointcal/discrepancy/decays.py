@@ -7,11 +7,14 @@ are the modal stage's (``backbone.csv``): every ring-down window (a dwell's own 
 level's dwells once by their phase resonance (``q_dwell_quad_in``, ``f_dwell_quad_hz``, ``zeta_dwell_quad``
 of ``modal_properties.csv``, as the calibration takes them).
 
-**Scatter.** Each point's relative errors are scaled by the read-outs' own scatter: along each ring-down
-the windows' f and zeta about a quadratic in log q (the backbone is smooth over a decade), pooled over the
-runs with their degrees of freedom, never below the sweeps' floors in the validation's convention
-(`jointcal.validate.decay.scales`: 0.05 dB a relative damping of 0.58%, 0.3 deg a relative frequency of
-zeta x 0.3 deg in rad).
+**Scatter.** Each point's relative errors are scaled by the read-out's own standard errors of f and zeta
+(``f_se_hz``, ``zeta_se`` of each window, `jointcal.measure.ringdown.ringdown_backbone`, given as `se`: the
+ring-downs read again as the modal stage and the validation read them), never below the sweeps' floors in the
+validation's convention (`jointcal.validate.decay.scales`: 0.05 dB a relative damping of 0.58%, 0.3 deg a
+relative frequency of zeta x 0.3 deg in rad): the same scale as the validation's E of the decays. Without
+them (no record), the windows' scatter about a quadratic in log q per run, pooled (`read_scatter`); it takes
+the backbone's curvature for noise where a run spans two decades (the virtual Ministack: 7e-4 against the
+read-out's 5e-5 to 9e-5 in f).
 
 **E.** As the validation's: the RMS of the scaled errors of f and zeta, every run weighted equally
 (a ring-down counts once, however many windows it has, as in the calibration).
@@ -115,8 +118,24 @@ def _points(backbone: pd.DataFrame, modal: pd.DataFrame, rows: Sequence[Mapping]
     return out
 
 
+def _own_se(q: NDArray, f: NDArray, z: NDArray, windows: pd.DataFrame | None) -> tuple[NDArray, NDArray] | None:
+    """The read-out's relative standard errors of f and zeta at amplitudes q (interpolated in log q along the
+    windows read again from the record), None without them."""
+    if windows is None or not {"q_in", "f_hz", "zeta", "f_se_hz", "zeta_se"} <= set(windows.columns):
+        return None
+    w = windows[(windows["q_in"] > 0) & np.isfinite(windows["f_se_hz"]) & np.isfinite(windows["zeta_se"])]
+    if w.empty:
+        return None
+    w = w.sort_values("q_in")
+    lq = np.log(w["q_in"].to_numpy(float))
+    at = lambda v: np.interp(np.log(q), lq, v)  # noqa: E731
+    return (at((w["f_se_hz"] / w["f_hz"]).to_numpy(float)) * f,
+            at((w["zeta_se"] / w["zeta"].abs()).to_numpy(float)) * z)
+
+
 def decay_runs(backbone: pd.DataFrame, modal: pd.DataFrame, rows: Sequence[Mapping], *, floor_db: float = 0.05,
-               floor_deg: float = 0.3, bands: int = BANDS) -> list[DecayRun]:
+               floor_deg: float = 0.3, bands: int = BANDS,
+               se: Mapping[str, pd.DataFrame] | None = None) -> list[DecayRun]:
     """The assembly's backbone points as `DecayRun` pieces (each run split into amplitude bands).
 
     Parameters
@@ -131,6 +150,9 @@ def decay_runs(backbone: pd.DataFrame, modal: pd.DataFrame, rows: Sequence[Mappi
         The validation's floors (`ValidateSettings`), in the convention of `jointcal.validate.decay.scales`.
     bands : int
         Amplitude bands, equal in log q between the campaign's smallest and largest point.
+    se : mapping run_id -> DataFrame, optional
+        Each ring-down's windows read again from its record (q_in, f_hz, zeta, f_se_hz, zeta_se): the
+        read-out's own standard errors; a run without them takes the pooled scatter (`read_scatter`).
     """
     pts = _points(backbone, modal, rows)
     if not pts:
@@ -141,8 +163,10 @@ def decay_runs(backbone: pd.DataFrame, modal: pd.DataFrame, rows: Sequence[Mappi
     out = []
     for row, p in pts:
         q, f, z = (p[c].to_numpy(float) for c in ("q_in", "f_hz", "zeta"))
-        se = pd.DataFrame({"f_hz": f, "zeta": z, "f_se_hz": np.nan_to_num(sf) * f, "zeta_se": np.nan_to_num(sz) * z})
-        s_f, s_z = scales(se, floor_db=floor_db, floor_deg=floor_deg)
+        own = _own_se(q, f, z, (se or {}).get(str(row["run_id"])))
+        f_se, z_se = own if own is not None else (np.nan_to_num(sf) * f, np.nan_to_num(sz) * z)
+        s_f, s_z = scales(pd.DataFrame({"f_hz": f, "zeta": z, "f_se_hz": f_se, "zeta_se": z_se}), floor_db=floor_db,
+                          floor_deg=floor_deg)
         b = np.clip(np.digitize(np.log(q), edges[1:-1]), 0, bands - 1)
         col = level_column(row)
         for k in np.unique(b):
