@@ -9,7 +9,8 @@ the rule, GA + posterior recalibration, revalidation by the decays' time simulat
 named, confidence, the time-domain E before and after, the backbone's floor, the named effect's parameter against
 the truth's (per unit modal mass of the rig's mode, beam and armature, for k3), the stage's time.
 
-    python tests/benchmarks/accept_discrepancy_decays.py [--seeds 1,2,3] [--only NAME] [--out FILE]
+    python tests/benchmarks/accept_discrepancy_decays.py [--rig beam|ministack] [--seeds 1,2,3] [--only NAME]
+        [--out FILE]
 
 A channel delay is hidden too: a free decay cannot show it, so 'none' is the right answer from ring-downs (the
 stage does not try it and says so).
@@ -25,7 +26,7 @@ from pathlib import Path
 import yaml
 
 sys.path.insert(0, str(Path(__file__).parents[2]))
-from tests._support.decay_campaign import calibrate_and_diagnose, ring_down_campaign  # noqa: E402
+from tests._support.decay_campaign import calibrate_and_diagnose, ministack_ring_downs, ring_down_campaign  # noqa: E402
 
 from jointcal.discrepancy import DiscrepancySettings  # noqa: E402
 
@@ -42,22 +43,35 @@ CASES = [
 ]
 
 
-def _truth_value(name: str, value: float) -> float:
-    return value / M_RIG if name == "k3" else value
+MINISTACK = [  # the base-driven Ministack (first assembly, four ring-downs 0.3-10 g, 0.1% noise), hidden strengths
+    ("none", {}, "none"),  # the library's defaults
+    ("cubic_stiffening", {"k3": 5e11}, "cubic_stiffening"),
+    ("cubic_stiffening", {"k3": 2e12}, "cubic_stiffening"),
+    ("quadratic_damping", {}, "quadratic_damping"),
+    ("channel_delay", {"tau_s": 4e-5}, "none"),
+]
 
 
-def run_case(effect: str, params: dict, seed: int) -> dict:
+def _truth_value(name: str, value: float, rig: str) -> float:
+    return value / M_RIG if name == "k3" and rig == "beam" else value
+
+
+def run_case(effect: str, params: dict, seed: int, rig: str = "beam") -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         p = {k: v for k, v in params.items() if k != "also"}
         t0 = time.perf_counter()
-        ring_down_campaign(folder, effect, p, seed=seed, also=params.get("also"))
+        if rig == "beam":
+            ring_down_campaign(folder, effect, p, seed=seed, also=params.get("also"))
+        else:
+            ministack_ring_downs(folder, effect, p or None, seed=seed)
         t1 = time.perf_counter()
-        d = calibrate_and_diagnose(folder, DiscrepancySettings.from_config(CONFIG["discrepancy"]))["diagnosis"]
+        d = calibrate_and_diagnose(folder, DiscrepancySettings.from_config(CONFIG["discrepancy"]),
+                                   assembly="beam" if rig == "beam" else "first")["diagnosis"]
         t2 = time.perf_counter()
     eff = d["recalibrated"]["effect_parameters"]
     truth = {**p, **(params.get("also", {}).get("params", {}))}
-    got = "; ".join(f"{k} {v['value']:.3g} (truth {_truth_value(k, truth[k]):.3g})" if k in truth else
+    got = "; ".join(f"{k} {v['value']:.3g} (truth {_truth_value(k, truth[k], rig):.3g})" if k in truth else
                     f"{k} {v['value']:.3g}" for k, v in eff.items())
     return dict(effect=d["effect"], confidence=d["confidence"], E_before=d["metric_before"], E_after=d["metric_after"],
                 floor=d["fast_model_floor"]["E"], params=got, stage_s=t2 - t1, total_s=t2 - t0,
@@ -69,14 +83,15 @@ def main(argv=None):
     ap.add_argument("--seeds", default="1,2,3")
     ap.add_argument("--only", default=None)
     ap.add_argument("--out", default=None)
+    ap.add_argument("--rig", default="beam", choices=("beam", "ministack"))
     a = ap.parse_args(argv)
     lines = []
-    for effect, params, want in CASES:
+    for effect, params, want in (CASES if a.rig == "beam" else MINISTACK):
         label = want if effect != "channel_delay" else "channel_delay"
         if a.only and a.only not in (effect, label):
             continue
         for seed in [int(s) for s in a.seeds.split(",")]:
-            r = run_case(effect, params, seed)
+            r = run_case(effect, params, seed, a.rig)
             ok = "ok" if r["effect"] == want else "MISS"
             change = r["E_after"] / r["E_before"] - 1
             line = (f"{label:36s} seed {seed}: {r['effect']:36s} {r['confidence']:6s} E {r['E_before']:6.2f} -> "
