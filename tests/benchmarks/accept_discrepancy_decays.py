@@ -15,7 +15,43 @@ the truth's (per unit modal mass of the rig's mode, beam and armature, for k3), 
 A channel delay is hidden too: a free decay cannot show it, so 'none' is the right answer from ring-downs (the
 stage does not try it and says so).
 
-Measured 2026-11-26 (loaded 2-core machine), see the table at the end of this docstring once run.
+Measured 2026-11-26, the jointed beam (voltage), seeds 1-3, on a loaded 2-core machine (hidden effect, seed: named,
+confidence, time-domain E of the calibrated model -> the named model recalibrated, the backbone's floor against the
+time simulation, right or not, the named effect's recalibrated parameters, the stage's time):
+
+    none                                 seed 1: none                                 high   E   0.82 ->  0.82 (  -1%)  floor 0.29  ok     stage 17 s
+    none                                 seed 2: none                                 high   E   1.15 ->  0.96 ( -16%)  floor 0.29  ok     stage 16 s
+    none                                 seed 3: none                                 high   E   0.85 ->  0.85 (  -0%)  floor 0.30  ok     stage 22 s
+    cubic_stiffening                     seed 1: cubic_stiffening                     high   E  14.26 ->  1.26 ( -91%)  floor 0.28  ok   k3 4.11e+08 (truth 3.68e+08)  stage 30 s
+    cubic_stiffening                     seed 2: cubic_stiffening                     high   E  12.96 ->  1.17 ( -91%)  floor 0.31  ok   k3 4.05e+08 (truth 3.68e+08)  stage 24 s
+    cubic_stiffening                     seed 3: cubic_stiffening                     medium E  15.75 ->  5.68 ( -64%)  floor 3.53  ok   k3 3.91e+08 (truth 3.68e+08)  stage 36 s
+    elastic_softening                    seed 1: elastic_softening                    high   E   7.81 ->  1.07 ( -86%)  floor 0.17  ok   loss_ratio 0.269 (truth 0.3)  stage 25 s
+    elastic_softening                    seed 2: elastic_softening                    high   E   8.09 ->  1.03 ( -87%)  floor 0.14  ok   loss_ratio 0.267 (truth 0.3)  stage 26 s
+    elastic_softening                    seed 3: elastic_softening                    high   E   8.50 ->  1.00 ( -88%)  floor 0.15  ok   loss_ratio 0.27 (truth 0.3)  stage 61 s
+    joint_settling                       seed 1: joint_settling                       high   E  10.22 ->  0.88 ( -91%)  floor 0.30  ok   Fs_drift 1 (truth 0.15); KT_drift 0.363 (truth 0.1); n_settle 3.82  stage 35 s
+    joint_settling                       seed 2: joint_settling                       high   E  11.05 ->  0.90 ( -92%)  floor 0.32  ok   Fs_drift 0.0147 (truth 0.15); KT_drift 0.017 (truth 0.1); n_settle 2.65  stage 63 s
+    joint_settling                       seed 3: joint_settling                       medium E  11.23 ->  3.70 ( -67%)  floor 2.72  ok   Fs_drift 0.238 (truth 0.15); KT_drift 0.147 (truth 0.1); n_settle 2.78  stage 61 s
+    channel_delay                        seed 1: none                                 high   E   0.81 ->  0.81 (  -1%)  floor 0.29  ok     stage 17 s
+    channel_delay                        seed 2: none                                 high   E   1.43 ->  0.90 ( -37%)  floor 0.30  ok     stage 21 s
+    channel_delay                        seed 3: none                                 high   E   0.89 ->  0.86 (  -4%)  floor 0.31  ok     stage 21 s
+    elastic_softening+cubic_stiffening   seed 1: elastic_softening+cubic_stiffening   high   E  10.84 ->  1.07 ( -90%)  floor 0.10  ok   loss_ratio 0.286 (truth 0.3); k3 4.22e+08 (truth 3.68e+08)  stage 23 s
+    elastic_softening+cubic_stiffening   seed 2: elastic_softening+cubic_stiffening   high   E  10.26 ->  1.07 ( -90%)  floor 0.12  ok   loss_ratio 0.282 (truth 0.3); k3 4.32e+08 (truth 3.68e+08)  stage 28 s
+    elastic_softening+cubic_stiffening   seed 3: elastic_softening+cubic_stiffening   high   E   9.90 ->  1.05 ( -89%)  floor 0.10  ok   loss_ratio 0.307 (truth 0.3); k3 4.05e+08 (truth 3.68e+08)  stage 23 s
+
+The right name in 18 of 18 campaigns ('none' for the delay, which the stage does not try and says so); confidence
+high and E falling by 86-92% in 16. The two medium rows (seed 3 of cubic_stiffening and of joint_settling) have a
+floor of 3.5 and 2.7 (rule.FLOOR_HIGH caps them) and E falling by 64-67%: there the calibration put the baseline's
+macroslip knee inside the top ring-down's first windows, whose f and zeta change within a window (the read-out of
+the time simulation reads 95.62 Hz and zeta 0.0212 where the backbone gives 96.0 Hz and 0.0173 one window later),
+and the recalibrated model keeps it. A read-out factor like the sweeps' transient factor (the time simulation's
+read-out over the backbone, taken at the fit and refreshed) would take that out; not built. joint_settling is named
+but its drifts are not identified (Fs_drift 0.01 to 1 against 0.15): each ring-down is one level and one place in
+the sequence, so the drift and the amplitude trade.
+
+The base-driven Ministack (--rig ministack, seed 5), k3 at the library's default 5e11 lbf/in^3: unexplained, low
+(fast scores baseline 1.97, cubic 1.77, floor 1.58: 'none' medium, which the time simulation contradicts, E 2.32
+before, 1.97 after). Its four ring-downs reach 1.3e-4 in, where the cubic's 3/4 k3 q^2 is 0.4% of the stuck
+stiffness, and the backbone's floor there is above the scatter: not met on the Ministack.
 """
 import argparse
 import sys
