@@ -39,7 +39,7 @@ time simulation, right or not, the named effect's recalibrated parameters, the s
     elastic_softening+cubic_stiffening   seed 3: elastic_softening+cubic_stiffening   high   E   9.90 ->  1.05 ( -89%)  floor 0.10  ok   loss_ratio 0.307 (truth 0.3); k3 4.05e+08 (truth 3.68e+08)  stage 23 s
 
 The right name in 18 of 18 campaigns ('none' for the delay, which the stage does not try and says so); confidence
-high and E falling by 86-92% in 16. The two medium rows (seed 3 of cubic_stiffening and of joint_settling) have a
+high in 16: the six 'none' and ten of the twelve with an effect, E falling by 86-92% in those ten. The two medium rows (seed 3 of cubic_stiffening and of joint_settling) have a
 floor of 3.5 and 2.7 (rule.FLOOR_HIGH caps them) and E falling by 64-67%: there the calibration put the baseline's
 macroslip knee inside the top ring-down's first windows, whose f and zeta change within a window (the read-out of
 the time simulation reads 95.62 Hz and zeta 0.0212 where the backbone gives 96.0 Hz and 0.0173 one window later),

@@ -82,8 +82,9 @@ CASES = [("none", {}), ("cubic_stiffening", {"k3": 1e6}), ("elastic_softening", 
 def test_ring_downs_alone_name_the_hidden_effect(tmp_path, effect, params):
     """Three ring-downs (steady amplitudes 1e-3, 3e-3, 8e-3 in, 0.5% noise) of the voltage-driven beam, the effect
     hidden in the exact time simulation; calibrated from them alone (a shorter GA), then diagnosed. Measured
-    (seed 1, default GA and stage settings): none -> none, high (E 0.82 -> 0.82); cubic_stiffening -> named,
-    high, E 14.3 -> 1.2; elastic_softening -> named, high, E 7.8 -> 1.1. About 12 s of CPU each (70-140 s of
+    (seed 1, default GA and stage settings, tests/benchmarks/accept_discrepancy_decays.py): none -> none, high
+    (E 0.82 -> 0.82); cubic_stiffening -> named, high, E 14.3 -> 1.3; elastic_softening -> named, high,
+    E 7.8 -> 1.1. About 12 s of CPU each (70-140 s of
     wall time on the loaded 2-core machine)."""
     ring_down_campaign(tmp_path, effect, params, seed=1)
     res = calibrate_and_diagnose(tmp_path, DiscrepancySettings(ga_generations=10, posterior_steps=200),
