@@ -1,14 +1,15 @@
 """The discrepancy stage for a campaign of ring-downs (and dwells): the same steps as the sweeps' (`stage`).
 
 0. Points and floor: the backbone points of every ring-down and each level's dwells (`decays.decay_runs`),
-   scaled by the read-out's own standard errors (the ring-downs read again from their records, `read_again`); the fast model's floor F is its backbone of the calibrated model
-   (`models.free_decay`) against that model's time simulation read by the same estimator at the same
-   windows (the validation's frames: `jointcal.validate.decay`), in the same E.
+   scaled by the read-out's own standard errors (the ring-downs read again from their records, `read_again`);
+   the fast model's floor F is its backbone of the calibrated model (`models.free_decay`) against that model's
+   time simulation read by the same estimator at the same windows (the validation's frames:
+   `jointcal.validate.decay`), in the same E.
 1. Candidates: the baseline and every library effect a decay can show. An effect whose parameters do not
    change the backbone (a channel delay: a free decay has no phase against a drive; a neighbouring mode: the
    read-out band-passes the mode) or that has none (a flexible fixture: no one-DOF backbone) is not tried,
    and the diagnosis says so (``not_seen_by_decays``): it must not be named from decays.
-2. Each refit on the points (`decays.DecayObjective`), scored on held-out runs and amplitude bands
+2. Each refit on the points (`decays.DecayObjective`), scored on held-out runs (amplitude bands on request)
    (`decays.decay_folds`, `select.score_candidates`); pairs by forward selection when the rule asks.
 3. Decide by `rule.decide` with F; 4. recalibrate the named (or baseline) model by the calibration's GA and
    the posterior in the grown space (`recalibrate`); revalidate every run by the time simulation
@@ -193,8 +194,8 @@ def diagnose_decays(assembly: str, backbone: pd.DataFrame, modal: pd.DataFrame, 
         max_nfev=2 * settings.max_nfev) for th in joint_starts]
     rec = recalibrate(cf, runs, starts, seed=settings.seed, generations=settings.ga_generations,
                       steps=settings.posterior_steps, max_nfev=2 * settings.max_nfev, objective=DecayObjective)
-    say(f"{assembly}: decision {decision.effect} ({decision.confidence}); {named.name} recalibrated, E {rec.fit.E:.2f}; "
-        "revalidating with the time simulation")
+    say(f"{assembly}: decision {decision.effect} ({decision.confidence}); {named.name} recalibrated, "
+        f"E {rec.fit.E:.2f}; revalidating with the time simulation")
     v_after = validate_runs([model_at(cf, rec.fit.theta, r) for r in rows], records, rows, **vkw)
     metric_after = float(v_after.error["E"])
     effect, confidence, note = confirm(decision.effect, decision.confidence, float(metric_before), metric_after)

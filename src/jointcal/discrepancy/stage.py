@@ -309,7 +309,8 @@ def run_discrepancy(assembly: str, *, runs_csv, modal_csv, envelope_files: Seque
 
     Reads runs.csv, this unit's modal_properties.csv, the runs' envelopes and records, the
     calibration (ga_best.json, ga_history.csv) and the validation (summary.json and its
-    envelopes/ beside it), and backbone.csv (`backbone_csv`, for a campaign of ring-downs and dwells); `diagnose`s; writes ``out``'s diagnosis (json), markdown, residuals,
+    envelopes/ beside it), and backbone.csv (`backbone_csv`, for a campaign of ring-downs and dwells);
+    `diagnose`s; writes ``out``'s diagnosis (json), markdown, residuals,
     metrics_after, residual_figure and before_after_figure. ``config`` holds the config's
     discrepancy, calibrate, validate, envelopes and modal sections. Returns the diagnosis.
     """
