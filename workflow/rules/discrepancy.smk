@@ -7,6 +7,7 @@ rule discrepancy_assembly:
     input:
         runs=INGEST / "runs.csv",
         modal=MODAL / "{assembly}" / "{mode}" / "modal_properties.csv",
+        backbone=MODAL / "{assembly}" / "{mode}" / "backbone.csv",  # ring-down windows, dwells' phase resonance
         env=expand(ENVELOPES / "{run_id}.csv", run_id=RUN_IDS),
         best=CALIBRATION / "{assembly}" / "{mode}" / "ga_best.json",
         history=CALIBRATION / "{assembly}" / "{mode}" / "ga_history.csv",

@@ -17,6 +17,6 @@ with stage_job(snakemake, errors=(ValueError, KeyError)) as job:  # noqa: F821 (
         d = run_discrepancy(asm, runs_csv=smk.input.runs, modal_csv=smk.input.modal, envelope_files=smk.input.env,
                             record_files=smk.input.records, best_json=smk.input.best,
                             history_csv=smk.input.history, validation_json=smk.input.validation,
-                            out=out, config=config, executor=ex, log=job.log)
+                            out=out, config=config, executor=ex, log=job.log, backbone_csv=smk.input.backbone)
     job.log(f"{asm}: {d['effect']} ({d['confidence']}); E {d['metric_before']:.2f} -> {d['metric_after']:.2f}; "
             f"{d['seconds']:.0f} s")

@@ -7,7 +7,8 @@ frames and the run's drive), `fit` (the swept fast-model envelope objective and 
 `floor` (the fast model's own error against the time simulation), `fingerprints`
 (residual maps, fingerprint features), `select` (held-out scoring, forward selection), `rule`
 (the decision rule), `recalibrate` (GA, polish, posterior of the chosen model), `stage`
-(one assembly, end to end), `words` (the diagnosis in plain language).
+(one assembly, end to end), `words` (the diagnosis in plain language). A campaign of ring-downs and
+dwells: `decays` (their backbone points and the objective on them) and `decay_stage` (its steps).
 
 The effects themselves are imported from `jointcal.effects` (one import path).
 """

@@ -80,14 +80,15 @@ def _posterior(obj: Objective, at: Fit, temperature: float) -> ResidualPosterior
 
 def recalibrate(c: Candidate, runs: Sequence[RunEnvelope], starts: Sequence[Fit], *, seed: int = 2017,
                 population: int = 48, generations: int = 30, walkers: int = 32, steps: int = 800,
-                max_nfev: int = 50) -> Recalibration:
+                max_nfev: int = 50, objective=Objective) -> Recalibration:
     """GA + polish + emcee of candidate `c` on the runs' envelopes (see the module notes).
 
     starts : least-squares fits of `c` (e.g. from the calibration's optimum and other valleys)
-    seeded into the GA's initial population. seed : seeds the GA and the sampler.
+    seeded into the GA's initial population. seed : seeds the GA and the sampler. objective : the
+    candidate's objective on the runs (the sweeps' `Objective`; ring-downs: `decays.DecayObjective`).
     """
     first = min(starts, key=lambda f: f.E)
-    obj = Objective(c, runs).at(first.theta)  # the sweep transient at the best start
+    obj = objective(c, runs).at(first.theta)  # the sweep transient at the best start
     lp = _posterior(obj, first, 1.0)
     init = np.array([np.clip(c.to_unit(f.theta), 0.0, 1.0)[lp.free] for f in starts]).reshape(-1, lp.ndim)
     options = GAOptions(population=population, offspring=population, generations=generations, stall_generations=8,

@@ -107,24 +107,27 @@ def _rms(values) -> float:
 
 def score_candidates(cands: Sequence[Candidate], runs: Sequence[RunEnvelope], theta_base, *,
                      max_nfev: int = 40, log=None, baseline: Scored | None = None,
-                     starts: dict[str, Sequence[np.ndarray]] | None = None) -> list[Scored]:
+                     starts: dict[str, Sequence[np.ndarray]] | None = None, objective=Objective,
+                     folds: dict[str, list[int]] | None = None) -> list[Scored]:
     """Fit every candidate on all runs, then score it on held-out folds (see the module notes).
 
     The baseline is scored first (added if `cands` lacks it and `baseline` is not given): the
     other scores refer to it. Each fit refreshes the runs' sweep transient at its optimum,
     and the folds keep the full fit's. starts : candidate name -> physical starts (joint
     parameters and the values of its first effects, e.g. a single effect's fit for a pair);
-    the fit from each is made and the lowest E on all runs kept (default: theta_base).
+    the fit from each is made and the lowest E on all runs kept (default: theta_base). objective : the
+    objective of a candidate on the runs (the sweeps' `Objective`; ring-downs: `decays.DecayObjective`);
+    folds : the held-out folds (default: the sweeps' levels, directions and rates, `_folds`).
     """
     cands = sorted(cands, key=lambda c: c.name != "baseline")
     if baseline is None and (not cands or cands[0].name != "baseline"):
         cands = [Candidate("baseline", cands[0].space, cands[0].m), *cands]
-    folds = _folds(runs)
+    folds = _folds(runs) if folds is None else folds
     out, base_per = [], (baseline.held_out if baseline is not None else {})
     base_score = baseline.score if baseline is not None else None
     for c in cands:
         t0 = time.perf_counter()
-        obj = Objective(c, runs)
+        obj = objective(c, runs)
         fits = [obj.fit(start, starts=1 if c.name == "baseline" else 3, max_nfev=max_nfev, refresh=1)
                 for start in (starts or {}).get(c.name, [theta_base])]
         full = min(fits, key=lambda f: f.E)

@@ -16,6 +16,10 @@
    runs) -> metric_before, metric_after. A 'none' that the time simulation contradicts
    (E above `rule.NONE_E` before and after) becomes 'unexplained'; a name the time
    simulation does not confirm (E not lower after) keeps confidence low.
+
+A campaign of ring-downs and dwells alone (no sweep) takes the same steps on its backbone points
+(`decay_stage.diagnose_decays`: each candidate's free-decay backbone, held-out runs, the same rule,
+recalibration and time-domain revalidation of the decays).
 """
 from __future__ import annotations
 
@@ -30,13 +34,14 @@ import pandas as pd
 from ..calibrate.space import PARAMS, ParamSpace
 from ..effects import EFFECTS, effects_of
 from ..calibrate.kind import backbone_at
-from ..io import level_column
+from ..io import level_column, test_kind
 from ..io.contract import LEVEL
 from ..validate.drive import drive_gain
 from ..measure.envelopes import ZETA_MIN
 from ..posterior.sampler import TAU_FACTOR
 from ..validate import ValidateSettings, model_from_best, validate_runs
 from .data import run_envelope, scale_arrays
+from .decay_stage import diagnose_decays
 from .fingerprints import fingerprints, outside_library, residual_map, verdicts
 from .fit import Objective, candidate, model_at, structure_scales
 from .floor import fast_floor
@@ -97,7 +102,8 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
              validate_settings: ValidateSettings = ValidateSettings(), envelopes_kw: dict | None = None,
              modal_kw: dict | None = None, metric_before: float | None = None,
              frames_before: Mapping[str, pd.DataFrame] | None = None, executor=None,
-             joint_starts: Sequence[Sequence[float]] = (), log: Callable[[str], None] | None = None) -> dict:
+             joint_starts: Sequence[Sequence[float]] = (), log: Callable[[str], None] | None = None,
+             backbone: pd.DataFrame | None = None) -> dict:
     """Diagnose one assembly; returns the diagnosis (diagnosis.json's content plus tables and models).
 
     Parameters
@@ -111,7 +117,9 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     assembly's runs (for the time-simulation revalidation); metric_before : the validation
     stage's E (recomputed when None); joint_starts : further joint parameter sets (6,) from
     which the final model is also refit (e.g. the GA's best individual in each other valley:
-    eq. 3.9 leaves the Fs-KT split flat, the envelopes may not).
+    eq. 3.9 leaves the Fs-KT split flat, the envelopes may not); backbone : backbone.csv's rows of the
+    assembly's runs: a campaign without sweeps (ring-downs, dwells) is diagnosed from them
+    (`decay_stage.diagnose_decays`); a campaign with sweeps from the sweeps' envelopes, as before.
     """
     say = log or (lambda s: None)
     clock = _Clock()
@@ -122,6 +130,15 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     gain = drive_gain(modal[modal["assembly"] == assembly]) if level_column(modal.columns) != LEVEL["base"] else None
     if gain is not None:  # a force or voltage drives the mode through the campaign's modal constant
         rows = [{**r, "drive_gain": gain} for r in rows]
+    if backbone is not None and not any(test_kind(r) == "sweep" for r in rows):  # ring-downs and dwells alone
+        mine = modal[modal["assembly"] == assembly]
+        peak = mine.set_index("run_id")["mode_peak_hz"] if "mode_peak_hz" in mine else pd.Series(dtype=float)
+        return diagnose_decays(assembly, backbone, mine, best, records,
+                               [{"mode_hz": peak.get(r["run_id"]), **r} for r in rows], space=space, scales=scales,
+                               settings=settings, validate_settings=validate_settings,
+                               vkw=dict(envelopes_kw=envelopes_kw, modal_kw=modal_kw, executor=executor),
+                               metric_before=metric_before, frames_before=frames_before, joint_starts=joint_starts,
+                               log=say)
     theta0 = np.array([best[p] for p in PARAMS], dtype=float)
     vkw = dict(settings=validate_settings, envelopes_kw=envelopes_kw, modal_kw=modal_kw, executor=executor)
     if scale is None or frames_before is None:  # as the validation stage does: the calibrated model in time
@@ -287,12 +304,13 @@ def _recalibrated_json(final, cf, rec, n_fits) -> dict:
 
 def run_discrepancy(assembly: str, *, runs_csv, modal_csv, envelope_files: Sequence[str], record_files: Sequence[str],
                     best_json, history_csv, validation_json, out: Mapping[str, str], config: Mapping[str, Mapping],
-                    executor=None, log: Callable[[str], None] | None = None) -> dict:
+                    executor=None, log: Callable[[str], None] | None = None, backbone_csv=None) -> dict:
     """The stage for one (assembly, mode), from the files the workflow has to the files it writes.
 
     Reads runs.csv, this unit's modal_properties.csv, the runs' envelopes and records, the
     calibration (ga_best.json, ga_history.csv) and the validation (summary.json and its
-    envelopes/ beside it); `diagnose`s; writes ``out``'s diagnosis (json), markdown, residuals,
+    envelopes/ beside it), and backbone.csv (`backbone_csv`, for a campaign of ring-downs and dwells);
+    `diagnose`s; writes ``out``'s diagnosis (json), markdown, residuals,
     metrics_after, residual_figure and before_after_figure. ``config`` holds the config's
     discrepancy, calibrate, validate, envelopes and modal sections. Returns the diagnosis.
     """
@@ -300,7 +318,8 @@ def run_discrepancy(assembly: str, *, runs_csv, modal_csv, envelope_files: Seque
 
     from ..calibrate import CalibrateSettings
     from ..io import listed_record, read_run, write_bytes_atomic, write_csv_atomic, write_json_atomic
-    from ..report.discrepancy import before_after_figure, residual_map_figure
+    from ..report.discrepancy import (before_after_figure, decay_before_after_figure, decay_residual_figure,
+                                      residual_map_figure)
 
     runs = pd.read_csv(runs_csv, dtype={"flags": str})
     modal = pd.read_csv(modal_csv, dtype={"flags": str})  # this (assembly, mode)'s rows
@@ -318,12 +337,15 @@ def run_discrepancy(assembly: str, *, runs_csv, modal_csv, envelope_files: Seque
                    validate_settings=ValidateSettings.from_config(config.get("validate")),
                    envelopes_kw=dict(config["envelopes"]), modal_kw=dict(config["modal"]),
                    metric_before=float(summary["E"]), frames_before=before,
-                   joint_starts=valley_starts(pd.read_csv(history_csv), best), executor=executor, log=log)
+                   joint_starts=valley_starts(pd.read_csv(history_csv), best), executor=executor, log=log,
+                   backbone=pd.read_csv(backbone_csv) if backbone_csv is not None else None)
     d = res["diagnosis"]
     write_csv_atomic(res["residuals"], out["residuals"])
     write_csv_atomic(res["validation_after"].metrics, out["metrics_after"])
     write_bytes_atomic(diagnosis_markdown(d).encode(), out["markdown"])
-    residual_map_figure(res["residuals"], d, Path(out["residual_figure"]))
-    before_after_figure(before, res["validation_after"].frames, d, Path(out["before_after_figure"]))
+    decays = d.get("data") == "decays"
+    (decay_residual_figure if decays else residual_map_figure)(res["residuals"], d, Path(out["residual_figure"]))
+    (decay_before_after_figure if decays else before_after_figure)(before, res["validation_after"].frames, d,
+                                                                   Path(out["before_after_figure"]))
     write_json_atomic(d, out["diagnosis"])
     return d

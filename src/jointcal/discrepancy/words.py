@@ -35,8 +35,8 @@ def _floor(d: Mapping) -> str:
         return "The fast model's own error could not be measured (no time-simulated frames of the calibrated model)."
     unit = d.get("level_unit", "g")
     per = ", ".join(f"{k} {unit}: {v:.2f}" for k, v in fl.get("per_level", {}).items())
-    return (f"The fast model's own error on the calibrated model (its envelopes against the time simulation of the "
-            f"same model, same runs and bins) is E = {fl['E']:.2f}" + (f" ({per})" if per else "") + ": "
+    what = fl.get("what", "its envelopes against the time simulation of the same model, same runs and bins")
+    return (f"The fast model's own error on the calibrated model ({what}) is E = {fl['E']:.2f}" + (f" ({per})" if per else "") + ": "
             + ("well below the repeat scatter, so the held-out scores measure the model, not the fast model."
                if fl["E"] <= 0.5 else "a share of the scores above is the fast model's own; the decision takes it out "
                "of the baseline's score." if fl["E"] <= FLOOR_HIGH else
@@ -144,4 +144,8 @@ def diagnosis_markdown(d: Mapping) -> str:
         lines += _named(d, E0, E1)
     lines += ["", "| model | held-out score |", "|---|---|", f"| baseline | {d['baseline']['held_out_score']:.2f} |"]
     lines += [f"| {c['name']} | {c['held_out_score']:.2f} |" for c in d["candidates"]]
+    blind = d.get("not_seen_by_decays") or {}
+    if blind:  # the decay path (`decay_stage`): effects a free decay cannot show were not tried
+        lines += ["", "Diagnosed from ring-downs and dwells. Not tried: "
+                  + "; ".join(f"`{k}` ({v})" for k, v in blind.items()) + "."]
     return "\n".join(lines) + "\n"

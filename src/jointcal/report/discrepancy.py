@@ -5,7 +5,7 @@ from collections.abc import Mapping
 
 import pandas as pd
 
-__all__ = ["residual_map_figure", "before_after_figure"]
+__all__ = ["residual_map_figure", "before_after_figure", "decay_residual_figure", "decay_before_after_figure"]
 
 
 def residual_map_figure(res: pd.DataFrame, diagnosis: Mapping, path) -> None:
@@ -63,6 +63,64 @@ def before_after_figure(frames_before: Mapping[str, pd.DataFrame], frames_after:
     ax.tick_params(labelsize=9)
     ax.legend(fontsize=7, ncol=2)
     ax.set_title(f"{diagnosis['assembly']}: measured (solid), calibrated model (dashed), with "
+                 f"{diagnosis['recalibrated']['model']} (dotted); E {diagnosis['metric_before']:.2f} -> "
+                 f"{diagnosis['metric_after']:.2f}", fontsize=10)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def decay_residual_figure(res: pd.DataFrame, diagnosis: Mapping, path) -> None:
+    """A ring-down campaign's baseline residuals: f and zeta of the refit backbone over the measured, in the
+    read-outs' scatter, against the amplitude, one line per run (`discrepancy.decay_stage`)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 1, figsize=(8, 6), sharex=True, constrained_layout=True)
+    for rid, r in res.groupby("run_id"):
+        r = r.sort_values("q_in")
+        axes[0].semilogx(r["q_in"], r["r_f"], "o-", ms=3, lw=1, label=str(rid))
+        axes[1].semilogx(r["q_in"], r["r_zeta"], "o-", ms=3, lw=1)
+    for ax, what in zip(axes, ("frequency", "damping")):
+        ax.axhspan(-1, 1, color="0.85", zorder=0)
+        ax.set_ylabel(f"{what} residual\n(read-out scatter units)", fontsize=10)
+        ax.tick_params(labelsize=9)
+    axes[0].legend(fontsize=7)
+    axes[1].set_xlabel("amplitude q (in)", fontsize=10)
+    axes[0].set_title(f"{diagnosis['assembly']}: baseline backbone / measured ring-downs; decision: "
+                      f"{diagnosis['effect']} ({diagnosis['confidence']})", fontsize=11)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def decay_before_after_figure(frames_before: Mapping[str, pd.DataFrame], frames_after: Mapping[str, pd.DataFrame],
+                              diagnosis: Mapping, path) -> None:
+    """Measured (points), calibrated (dashed) and corrected (dotted) ring-downs' f(q) and zeta(q), each model's
+    decay time-simulated from the record's state at the cut and read by the same estimator."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.5), constrained_layout=True)
+    cmap = plt.get_cmap("viridis", max(len(frames_after), 2))
+    for i, rid in enumerate(sorted(frames_after)):
+        for j, frames in enumerate((frames_after, frames_before)):
+            a = frames.get(rid)
+            if a is None or "part" not in a or not (a["part"] == "ringdown").any():
+                continue
+            a = a[a["part"] == "ringdown"].sort_values("q_meas_in")
+            for ax, col in zip(axes, ("f", "zeta")):
+                meas, sim = (f"{col}_meas_hz", f"{col}_sim_hz") if col == "f" else ("zeta_meas", "zeta_sim")
+                if j == 0:
+                    ax.semilogx(a["q_meas_in"], a[meas], "o", ms=3, color=cmap(i), label=rid)
+                ax.semilogx(a["q_meas_in"], a[sim], ":" if j == 0 else "--", color=cmap(i), lw=1.2)
+    axes[0].set_ylabel("frequency (Hz)", fontsize=10)
+    axes[1].set_ylabel("damping ratio", fontsize=10)
+    for ax in axes:
+        ax.set_xlabel("amplitude q (in)", fontsize=10)
+        ax.tick_params(labelsize=9)
+    axes[0].legend(fontsize=7)
+    fig.suptitle(f"{diagnosis['assembly']}: measured (points), calibrated model (dashed), with "
                  f"{diagnosis['recalibrated']['model']} (dotted); E {diagnosis['metric_before']:.2f} -> "
                  f"{diagnosis['metric_after']:.2f}", fontsize=10)
     fig.savefig(path, dpi=110)

@@ -6,7 +6,9 @@ The steps, in the order data flows (`decay_from_cut`, then `compare_decay`):
    acceleration as it is; a force or voltage through the campaign's modal constant), zero from where the
    record's decay starts (the drive cut), so that the model's own free decay starts from the steady state the measured dwell (or the
    impact) left it in. A record whose reference holds no drive (a ring-down whose drive file is missing; an
-   impact not recorded) is given a held sine at the measured decay's first frequency, cut at the decay's start.
+   impact not recorded), or a force or voltage the model cannot be driven by (no modal constant: a campaign of
+   ring-downs alone has no swept-mode fit and no level of dwells), is given a held sine at the measured decay's
+   first frequency, cut at the decay's start.
 2. **The state at the cut-off** (`decay_from_cut`): the input is scaled by a factor c until the model's decay,
    read at the measured decay's first window, has the measured amplitude there (within `TOL`; a secant in log c,
    at most `TRIES` simulations). The exact Iwan (`jointcal.models.simulate`) starts from rest, so the joint's
@@ -72,7 +74,8 @@ def decay_input(record: pd.DataFrame, row: Mapping, start: int, f_hz: float) -> 
     ref = record[col].to_numpy(float)
     fin = ref[np.isfinite(ref)]
     relative = col != REFERENCE["base"]
-    if fin.size and np.abs(fin - np.median(fin)).max() > 0:
+    gain_known = not relative or row.get("drive_gain") is not None  # a force or voltage drives through it
+    if fin.size and np.abs(fin - np.median(fin)).max() > 0 and gain_known:
         x = model_input(record, row)[0].copy()
         x[start:] = 0.0  # a free decay: the recorded drive's noise after the cut is no motion of the model's base
         return x, relative, "reference"

@@ -1,0 +1,151 @@
+"""Acceptance of the discrepancy stage from ring-downs (issue 31: "the discrepancy stage names a hidden effect from
+ring-downs").
+
+Each case: a virtual campaign of three ring-downs of the voltage-driven jointed beam (`tests/_support/decay_campaign.py`:
+dwells at the mode reaching 1e-3, 3e-3 and 8e-3 in, cut off, 1.5 s of free decay; the exact Iwan time simulation
+with the hidden effect; 0.5% noise), read by the modal stage, calibrated from the ring-downs alone with the
+workflow's default config, then `jointcal.discrepancy.diagnose` (the decay path: backbone points, held-out runs,
+the rule, GA + posterior recalibration, revalidation by the decays' time simulation). Prints per case: the effect
+named, confidence, the time-domain E before and after, the backbone's floor, the named effect's parameter against
+the truth's (per unit modal mass of the rig's mode, beam and armature, for k3), the stage's time.
+
+    python tests/benchmarks/accept_discrepancy_decays.py [--rig beam|ministack] [--seeds 1,2,3] [--only NAME]
+        [--out FILE]
+
+A channel delay is hidden too: a free decay cannot show it, so 'none' is the right answer from ring-downs (the
+stage does not try it and says so).
+
+Measured 2026-11-26, the jointed beam (voltage), seeds 1-3, on a loaded 2-core machine (hidden effect, seed: named,
+confidence, time-domain E of the calibrated model -> the named model recalibrated, the backbone's floor against the
+time simulation, right or not, the named effect's recalibrated parameters, the stage's time):
+
+    none                                 seed 1: none                                 high   E   0.82 ->  0.82 (  -1%)  floor 0.29  ok     stage 17 s
+    none                                 seed 2: none                                 high   E   1.15 ->  0.96 ( -16%)  floor 0.29  ok     stage 16 s
+    none                                 seed 3: none                                 high   E   0.85 ->  0.85 (  -0%)  floor 0.30  ok     stage 22 s
+    cubic_stiffening                     seed 1: cubic_stiffening                     high   E  14.26 ->  1.26 ( -91%)  floor 0.28  ok   k3 4.11e+08 (truth 3.68e+08)  stage 30 s
+    cubic_stiffening                     seed 2: cubic_stiffening                     high   E  12.96 ->  1.17 ( -91%)  floor 0.31  ok   k3 4.05e+08 (truth 3.68e+08)  stage 24 s
+    cubic_stiffening                     seed 3: cubic_stiffening                     medium E  15.75 ->  5.68 ( -64%)  floor 3.53  ok   k3 3.91e+08 (truth 3.68e+08)  stage 36 s
+    elastic_softening                    seed 1: elastic_softening                    high   E   7.81 ->  1.07 ( -86%)  floor 0.17  ok   loss_ratio 0.269 (truth 0.3)  stage 25 s
+    elastic_softening                    seed 2: elastic_softening                    high   E   8.09 ->  1.03 ( -87%)  floor 0.14  ok   loss_ratio 0.267 (truth 0.3)  stage 26 s
+    elastic_softening                    seed 3: elastic_softening                    high   E   8.50 ->  1.00 ( -88%)  floor 0.15  ok   loss_ratio 0.27 (truth 0.3)  stage 61 s
+    joint_settling                       seed 1: joint_settling                       high   E  10.22 ->  0.88 ( -91%)  floor 0.30  ok   Fs_drift 1 (truth 0.15); KT_drift 0.363 (truth 0.1); n_settle 3.82  stage 35 s
+    joint_settling                       seed 2: joint_settling                       high   E  11.05 ->  0.90 ( -92%)  floor 0.32  ok   Fs_drift 0.0147 (truth 0.15); KT_drift 0.017 (truth 0.1); n_settle 2.65  stage 63 s
+    joint_settling                       seed 3: joint_settling                       medium E  11.23 ->  3.70 ( -67%)  floor 2.72  ok   Fs_drift 0.238 (truth 0.15); KT_drift 0.147 (truth 0.1); n_settle 2.78  stage 61 s
+    channel_delay                        seed 1: none                                 high   E   0.81 ->  0.81 (  -1%)  floor 0.29  ok     stage 17 s
+    channel_delay                        seed 2: none                                 high   E   1.43 ->  0.90 ( -37%)  floor 0.30  ok     stage 21 s
+    channel_delay                        seed 3: none                                 high   E   0.89 ->  0.86 (  -4%)  floor 0.31  ok     stage 21 s
+    elastic_softening+cubic_stiffening   seed 1: elastic_softening+cubic_stiffening   high   E  10.84 ->  1.07 ( -90%)  floor 0.10  ok   loss_ratio 0.286 (truth 0.3); k3 4.22e+08 (truth 3.68e+08)  stage 23 s
+    elastic_softening+cubic_stiffening   seed 2: elastic_softening+cubic_stiffening   high   E  10.26 ->  1.07 ( -90%)  floor 0.12  ok   loss_ratio 0.282 (truth 0.3); k3 4.32e+08 (truth 3.68e+08)  stage 28 s
+    elastic_softening+cubic_stiffening   seed 3: elastic_softening+cubic_stiffening   high   E   9.90 ->  1.05 ( -89%)  floor 0.10  ok   loss_ratio 0.307 (truth 0.3); k3 4.05e+08 (truth 3.68e+08)  stage 23 s
+
+The right name in 18 of 18 campaigns ('none' for the delay, which the stage does not try and says so); confidence
+high in 16: the six 'none' and ten of the twelve with an effect, E falling by 86-92% in those ten. The two medium rows (seed 3 of cubic_stiffening and of joint_settling) have a
+floor of 3.5 and 2.7 (rule.FLOOR_HIGH caps them) and E falling by 64-67%: there the calibration put the baseline's
+macroslip knee inside the top ring-down's first windows, whose f and zeta change within a window (the read-out of
+the time simulation reads 95.62 Hz and zeta 0.0212 where the backbone gives 96.0 Hz and 0.0173 one window later),
+and the recalibrated model keeps it. A read-out factor like the sweeps' transient factor (the time simulation's
+read-out over the backbone, taken at the fit and refreshed) would take that out; not built. joint_settling is named
+but its drifts are not identified (Fs_drift 0.01 to 1 against 0.15): each ring-down is one level and one place in
+the sequence, so the drift and the amplitude trade.
+
+The base-driven Ministack (--rig ministack --only cubic_stiffening, seed 5):
+
+    cubic_stiffening k3 5e11  seed 5: unexplained  low  E  2.32 ->  1.97 (-15%)  floor  1.58  MISS  stage 213 s
+    cubic_stiffening k3 2e12  seed 5: unexplained  low  E 27.74 -> 26.27 ( -5%)  floor 19.99  MISS  stage 69 s
+
+At 5e11 (fast scores baseline 1.97, cubic 1.77, floor 1.58) the decision is 'none', medium, which the time
+simulation contradicts. At 2e12 the same cause as the beam's medium rows, stronger: the calibration (the Iwan
+alone, made to follow a hardening backbone) put the macroslip knee at the largest amplitude read (phi_max 9.71e-5
+in, q_max 9.72e-5 in, beta 1.2); the 10 g ring-down's time simulation then needs 8.4x the measured drive to start
+at the measured amplitude and its first window reads 2168 Hz and zeta 0.057 where the backbone gives 2201 Hz and
+0.025 (the run's E_f 50, E_zeta 60; the three lower runs E 0.9-3.4). Not met on the Ministack; the read-out factor
+above is the fix to try. 'none' and quadratic_damping rows not run (time).
+"""
+import argparse
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import yaml
+
+sys.path.insert(0, str(Path(__file__).parents[2]))
+from tests._support.decay_campaign import calibrate_and_diagnose, ministack_ring_downs, ring_down_campaign  # noqa: E402
+
+from jointcal.discrepancy import DiscrepancySettings  # noqa: E402
+
+CONFIG = yaml.safe_load((Path(__file__).parents[2] / "workflow" / "config" / "config.yaml").read_text())
+M_RIG = 1.05 / 386.089  # the rig's mode: the 1 lbf beam and the 0.05 lbf armature
+CASES = [
+    ("none", {}, "none"),
+    ("cubic_stiffening", {"k3": 1e6}, "cubic_stiffening"),
+    ("elastic_softening", {"loss_ratio": 0.3}, "elastic_softening"),
+    ("joint_settling", {"Fs_drift": 0.15, "KT_drift": 0.1}, "joint_settling"),
+    ("channel_delay", {"tau_s": 4e-4}, "none"),  # what a decay shows of it: nothing
+    ("elastic_softening", {"loss_ratio": 0.3, "also": {"name": "cubic_stiffening", "params": {"k3": 1e6}}},
+     "elastic_softening+cubic_stiffening"),
+]
+
+
+MINISTACK = [  # the base-driven Ministack (first assembly, four ring-downs 0.3-10 g, 0.1% noise), hidden strengths
+    ("none", {}, "none"),  # the library's defaults
+    ("cubic_stiffening", {"k3": 5e11}, "cubic_stiffening"),
+    ("cubic_stiffening", {"k3": 2e12}, "cubic_stiffening"),
+    ("quadratic_damping", {}, "quadratic_damping"),
+    ("channel_delay", {"tau_s": 4e-5}, "none"),
+]
+
+
+def _truth_value(name: str, value: float, rig: str) -> float:
+    return value / M_RIG if name == "k3" and rig == "beam" else value
+
+
+def run_case(effect: str, params: dict, seed: int, rig: str = "beam") -> dict:
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        p = {k: v for k, v in params.items() if k != "also"}
+        t0 = time.perf_counter()
+        if rig == "beam":
+            ring_down_campaign(folder, effect, p, seed=seed, also=params.get("also"))
+        else:
+            ministack_ring_downs(folder, effect, p or None, seed=seed)
+        t1 = time.perf_counter()
+        d = calibrate_and_diagnose(folder, DiscrepancySettings.from_config(CONFIG["discrepancy"]),
+                                   assembly="beam" if rig == "beam" else "first")["diagnosis"]
+        t2 = time.perf_counter()
+    eff = d["recalibrated"]["effect_parameters"]
+    truth = {**p, **(params.get("also", {}).get("params", {}))}
+    got = "; ".join(f"{k} {v['value']:.3g} (truth {_truth_value(k, truth[k], rig):.3g})" if k in truth else
+                    f"{k} {v['value']:.3g}" for k, v in eff.items())
+    return dict(effect=d["effect"], confidence=d["confidence"], E_before=d["metric_before"], E_after=d["metric_after"],
+                floor=d["fast_model_floor"]["E"], params=got, stage_s=t2 - t1, total_s=t2 - t0,
+                not_seen=",".join(d["not_seen_by_decays"]))
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", default="1,2,3")
+    ap.add_argument("--only", default=None)
+    ap.add_argument("--out", default=None)
+    ap.add_argument("--rig", default="beam", choices=("beam", "ministack"))
+    a = ap.parse_args(argv)
+    lines = []
+    for effect, params, want in (CASES if a.rig == "beam" else MINISTACK):
+        label = want if effect != "channel_delay" else "channel_delay"
+        if a.only and a.only not in (effect, label):
+            continue
+        for seed in [int(s) for s in a.seeds.split(",")]:
+            r = run_case(effect, params, seed, a.rig)
+            ok = "ok" if r["effect"] == want else "MISS"
+            change = r["E_after"] / r["E_before"] - 1
+            line = (f"{label:36s} seed {seed}: {r['effect']:36s} {r['confidence']:6s} E {r['E_before']:6.2f} -> "
+                    f"{r['E_after']:5.2f} ({change:+5.0%})  floor {r['floor']:.2f}  {ok:4s} {r['params']}  "
+                    f"stage {r['stage_s']:.0f} s")
+            print(line, flush=True)
+            lines.append(line)
+            if a.out:
+                Path(a.out).write_text("\n".join(lines) + "\n")
+
+
+if __name__ == "__main__":
+    main()
