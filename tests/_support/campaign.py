@@ -65,3 +65,32 @@ def unit(results: Path, assembly: str) -> str:
     modes = [m for a, m in modal_units(results / "modal" / "modal_properties.csv") if a == assembly]
     assert len(modes) == 1, modes
     return modes[0]
+
+
+def modal_tables(folder: Path) -> Path:
+    """The modal stage's three tables of the virtual campaign in folder/campaign (sweeps through their envelopes,
+    dwells and ring-downs from their records), written in folder/modal, as the workflow's modal rule writes them;
+    returns folder/modal."""
+    from jointcal.io import ingest_campaign, test_kind, write_csv_atomic
+    from jointcal.measure.campaign import campaign_modal
+    from jointcal.measure.envelopes import envelopes, meta_dict
+    from jointcal.measure.scatter import scatter
+    from jointcal.measure.testkinds import backbone_table
+
+    runs = ingest_campaign(folder / "campaign")
+
+    def load(row):
+        record = read_run(folder / "campaign" / row["file"], row)
+        if test_kind(row) != "sweep":
+            return None, {}, record
+        env, meta = envelopes(record, row)
+        return env, {**meta_dict(meta), "error": ""}, record
+
+    points: list = []
+    rows, _, _ = campaign_modal(runs, load, {}, points=points)
+    table = pd.DataFrame(rows)
+    modal = folder / "modal"
+    write_csv_atomic(table, modal / "modal_properties.csv")
+    write_csv_atomic(scatter(table), modal / "scatter.csv")
+    write_csv_atomic(backbone_table(table, points), modal / "backbone.csv")
+    return modal

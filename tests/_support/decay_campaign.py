@@ -20,11 +20,9 @@ from jointcal.calibrate import CalibrateSettings, run_calibration
 from jointcal.calibrate.ga import GAOptions
 from jointcal.discrepancy import DiscrepancySettings, diagnose
 from jointcal.discrepancy.stage import valley_starts
-from jointcal.io import ingest_campaign, read_manifest, read_run, write_csv_atomic
-from jointcal.measure.campaign import campaign_modal
-from jointcal.measure.scatter import scatter
-from jointcal.measure.testkinds import backbone_table
+from jointcal.io import read_manifest, read_run
 from jointcal.synth import generate
+from tests._support.campaign import modal_tables
 from tests._support.rigs import JOINTED_BEAM, SMALL_SHAKER, levels_V, truth_curve
 
 DWELL_S, DECAY_S = 1.5, 1.5  # s: the dwell reaches its steady state (zeta ~1.5%: 1/(zeta w) 0.11 s)
@@ -45,7 +43,7 @@ def ring_down_campaign(folder: Path, effect: str = "none", params: dict | None =
             "effect": {"name": effect, "params": params or {}, **({"also": also} if also else {})},
             "rig": {"reference": "voltage", "shaker": SMALL_SHAKER}}
     generate(spec, folder / "campaign", folder / "truth.json")
-    return _read(folder)
+    return modal_tables(folder)
 
 
 def ministack_ring_downs(folder: Path, effect: str = "none", params: dict | None = None, *, seed: int = 5,
@@ -67,20 +65,7 @@ def ministack_ring_downs(folder: Path, effect: str = "none", params: dict | None
             "measurement": {**DEFAULT_SPEC["measurement"], "noise_fraction": 1e-3, "dc_offset_g": 0.0},
             "effect": {"name": effect, "params": params or {}}}
     generate(spec, folder / "campaign", folder / "truth.json")
-    return _read(folder)
-
-
-def _read(folder: Path) -> Path:
-    runs = ingest_campaign(folder / "campaign")
-    points: list = []
-    rows, _, _ = campaign_modal(runs, lambda row: (None, {}, read_run(folder / "campaign" / row["file"], row)), {},
-                                points=points)
-    table = pd.DataFrame(rows)
-    modal = folder / "modal"
-    write_csv_atomic(table, modal / "modal_properties.csv")
-    write_csv_atomic(scatter(table), modal / "scatter.csv")
-    write_csv_atomic(backbone_table(table, points), modal / "backbone.csv")
-    return modal
+    return modal_tables(folder)
 
 
 def calibrate_and_diagnose(folder: Path, settings: DiscrepancySettings, *, ga: GAOptions | None = None,

@@ -9,7 +9,7 @@ time simulation, the shaker, the DAQ, 0.1% noise of each channel's rms, as in te
 ring-down's decades end at its noise floor, and 2% would leave half a decade)
 holds a ring-down cut off from a dwell at the top level's resonance, five dwells around the middle level's
 resonance (each with its own ring-down after the cut), and slow sweeps (eta 0.5) at three levels. Each run is
-read by the modal stage's functions (`campaign_modal`, `backbone_table`, `measure_run`), every point set beside
+read by the modal stage's functions (`tests/_support/campaign.modal_tables`), every point set beside
 the rig's truth at its own amplitude: the structure's first-harmonic balance (force: response / force is the
 structure alone; base: the Ministack's) or the coupled rig's pole (voltage: response / voltage holds the shaker).
 
@@ -54,15 +54,12 @@ import pandas as pd
 
 HERE = Path(__file__).parents[2]
 sys.path.insert(0, str(HERE))
-from jointcal.io import ingest_campaign, read_run, test_kind  # noqa: E402
-from jointcal.measure.envelopes import envelopes, meta_dict  # noqa: E402
-from jointcal.measure.campaign import campaign_modal  # noqa: E402
-from jointcal.measure.testkinds import backbone_table  # noqa: E402
 from jointcal.models import harmonic_balance  # noqa: E402
 from jointcal.synth import DEFAULT_SPEC, generate  # noqa: E402
 from jointcal.synth.rig_truth import rig_pole  # noqa: E402
 from jointcal.units import G  # noqa: E402
 from tests._support import rigs  # noqa: E402
+from tests._support.campaign import modal_tables  # noqa: E402
 
 FIRST = DEFAULT_SPEC["assemblies"]["first"]
 MINI = (FIRST["Fs"], FIRST["KT"], FIRST["chi"], FIRST["beta"], FIRST["k"], DEFAULT_SPEC["slug_weight_lbf"] / G,
@@ -88,14 +85,12 @@ def _beam_spec(ref: str, seed: int) -> tuple[dict, callable]:
 
 
 def _ministack_spec(seed: int) -> tuple[dict, callable]:
-    f_res = harmonic_balance(np.array([1e-4]), *MINI)[0][0]
     spec = {"seed": seed, "assemblies": {"first": FIRST},
             "series": [{"level_g": lev, "directions": ["up"]} for lev in (1.0, 2.0, 5.0)]
             + [{"level_g": 5.0, "test": "ringdown", "dwell_hz": [2180.0], "dwell_s": 0.3, "decay_s": 1.2},
                {"level_g": 2.0, "test": "dwell", "dwell_hz": [2140.0, 2160.0, 2180.0, 2200.0, 2220.0],
                 "dwell_s": 0.4, "decay_s": 1.2}],
             "measurement": {"noise_fraction": 1e-3, "dc_offset_g": 0.0}}
-    del f_res
     return spec, lambda q: harmonic_balance(np.asarray(q, float), *MINI)
 
 
@@ -104,19 +99,9 @@ NEAR = 1.5  # ring-down windows within this factor of a point's amplitude give t
 
 def case(name: str, spec: dict, truth, folder: Path) -> dict:
     generate(spec, folder / "campaign", folder / "truth.json")
-    runs = ingest_campaign(folder / "campaign")
-
-    def load(row):
-        record = read_run(folder / "campaign" / row["file"], row)
-        if test_kind(row) != "sweep":
-            return None, {}, record
-        env, meta = envelopes(record, row)
-        return env, {**meta_dict(meta), "error": ""}, record
-
-    points: list = []
-    rows, _, _ = campaign_modal(runs, load, {}, points=points)
-    table = pd.DataFrame(rows)
-    bb = backbone_table(table, points)
+    modal = modal_tables(folder)
+    table = pd.read_csv(modal / "modal_properties.csv", dtype={"flags": str})
+    bb = pd.read_csv(modal / "backbone.csv")
     f_t, z_t = truth(bb["q_in"].to_numpy())
     bb = bb.assign(df=bb["f_hz"] / f_t - 1, dz=bb["zeta"] / z_t - 1)
     rd = bb[bb["test"] == "ringdown"]

@@ -11,17 +11,14 @@ import pandas as pd
 import pytest
 
 from jointcal.calibrate import CalibrateSettings, objective, read_modal, run_calibration, select_modal
-from jointcal.io import ingest_campaign, read_run, write_csv_atomic
-from jointcal.io import test_kind as kind_of_run
-from jointcal.measure.campaign import campaign_modal
-from jointcal.measure.envelopes import envelopes, meta_dict
-from jointcal.measure.scatter import scatter
+from jointcal.io import write_csv_atomic
 from jointcal.measure.testkinds import backbone_table
 from jointcal.models import harmonic_balance, resonance_amplitude
 from jointcal.posterior import PosteriorSettings, run_posterior
 from jointcal.posterior.identified import identified_table, quantities
 from jointcal.synth import DEFAULT_SPEC, generate
 from jointcal.units import G
+from tests._support.campaign import modal_tables as campaign_tables
 from tests._support.modal_tables import TABLE_3_2, modal_tables
 
 FIRST = TABLE_3_2["first"]
@@ -105,23 +102,7 @@ def _campaign(folder: Path, sweeps: tuple, ring_downs: tuple, measurement: dict)
     spec = {**DEFAULT_SPEC, "seed": 5, "assemblies": {"first": DEFAULT_SPEC["assemblies"]["first"]},
             "series": series, "measurement": {**DEFAULT_SPEC["measurement"], **measurement}}
     generate(spec, folder / "campaign", folder / "truth.json")
-    runs = ingest_campaign(folder / "campaign")
-
-    def load(row):
-        record = read_run(folder / "campaign" / row["file"], row)
-        if kind_of_run(row) != "sweep":
-            return None, {}, record
-        env, meta = envelopes(record, row)
-        return env, {**meta_dict(meta), "error": ""}, record
-
-    points: list = []
-    rows, _, _ = campaign_modal(runs, load, {}, points=points)
-    table = pd.DataFrame(rows)
-    modal = folder / "modal"
-    write_csv_atomic(table, modal / "modal_properties.csv")
-    write_csv_atomic(scatter(table), modal / "scatter.csv")
-    write_csv_atomic(backbone_table(table, points), modal / "backbone.csv")
-    return modal
+    return campaign_tables(folder)
 
 
 def _calibrate_and_cover(folder: Path, modal: Path):
