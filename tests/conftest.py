@@ -3,11 +3,21 @@ to break; synthetic campaigns made once per session (the exact time simulation o
 seconds)."""
 from __future__ import annotations
 
-import shutil
-from pathlib import Path
+import os
 
-import pandas as pd
-import pytest
+# One BLAS thread per process, set before numpy is imported (here, in the process that starts the xdist workers,
+# so they inherit it): the suite already runs one worker per core (-n 2), and a second OpenBLAS thread per worker
+# oversubscribes the cores. The sweep fit's least squares takes an SVD of a (~1850, 14) Jacobian per step: 2.5 ms
+# with one thread, 60-380 ms with two on a busy 2-core machine (tests/benchmarks/bench_sweep_jacobian.py sets
+# the same). Snakemake sets these variables for its own jobs from each rule's `threads:`.
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+import shutil  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import pandas as pd  # noqa: E402
+import pytest  # noqa: E402
 
 pytest.register_assert_rewrite("tests._support")  # the helpers' asserts report as the tests' own do
 
