@@ -72,3 +72,33 @@ def default_modal(default_campaign_dir: Path) -> pd.DataFrame:
 def example(tmp_path: Path) -> Path:
     """Two clean runs of the example campaign, to break the first."""
     return example_copy(tmp_path / "campaign", RUN, OTHER)
+
+
+# ------------------------------------------------------------------ xdist: which worker runs what, in which order
+# pyproject's `--dist loadgroup` hands out one group at a time: each file is its own group (as `loadfile` did: its
+# module fixtures made once), except the files in SHARED, which share a session fixture too expensive to make on both
+# workers. Groups are handed out heaviest first (FIRST, measured on 2026-11-26), then the rest in collection order,
+# so that a long file does not start last and leave one worker idle at the end; the order only decides when a
+# file runs, never what it runs.
+SHARED = {"tests/test_pipeline.py": "default_campaign",  # default_campaign_dir and default_modal
+          "tests/measure/test_modal.py": "default_campaign"}
+FIRST = ("default_campaign", "tests/workflow/test_mechanics.py", "tests/discrepancy/test_select.py",
+         "tests/workflow/test_calibration.py", "tests/workflow/test_snakefile.py", "tests/validate/test_assembly.py",
+         "tests/workflow/test_modal_stage.py", "tests/discrepancy/test_stage.py", "tests/calibrate/test_readouts.py",
+         "tests/workflow/test_input_mistakes.py", "tests/measure/test_coil.py")
+
+
+@pytest.hookimpl(tryfirst=True)  # before xdist's own hook reads the xdist_group marks
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    def group(item: pytest.Item) -> str:
+        mark = item.get_closest_marker("xdist_group")
+        if mark is not None:
+            return str(mark.args[0] if mark.args else mark.kwargs.get("name", "default"))
+        path = item.nodeid.split("::", 1)[0]
+        return SHARED.get(path, path)
+
+    for item in items:
+        if item.get_closest_marker("xdist_group") is None:
+            item.add_marker(pytest.mark.xdist_group(group(item)))
+    rank = {name: i for i, name in enumerate(FIRST)}
+    items.sort(key=lambda item: rank.get(group(item), len(FIRST)))  # stable: the rest keep their order
