@@ -3,11 +3,21 @@ to break; synthetic campaigns made once per session (the exact time simulation o
 seconds)."""
 from __future__ import annotations
 
-import shutil
-from pathlib import Path
+import os
 
-import pandas as pd
-import pytest
+# One BLAS thread per process, set before numpy is imported (here, in the process that starts the xdist workers,
+# so they inherit it): the suite already runs one worker per core (-n 2), and a second OpenBLAS thread per worker
+# oversubscribes the cores. The sweep fit's least squares takes an SVD of a (~1850, 14) Jacobian per step: 2.5 ms
+# with one thread, 60-380 ms with two on a busy 2-core machine (tests/benchmarks/bench_sweep_jacobian.py sets
+# the same). Snakemake sets these variables for its own jobs from each rule's `threads:`.
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+import shutil  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import pandas as pd  # noqa: E402
+import pytest  # noqa: E402
 
 pytest.register_assert_rewrite("tests._support")  # the helpers' asserts report as the tests' own do
 
@@ -62,3 +72,33 @@ def default_modal(default_campaign_dir: Path) -> pd.DataFrame:
 def example(tmp_path: Path) -> Path:
     """Two clean runs of the example campaign, to break the first."""
     return example_copy(tmp_path / "campaign", RUN, OTHER)
+
+
+# ------------------------------------------------------------------ xdist: which worker runs what, in which order
+# pyproject's `--dist loadgroup` hands out one group at a time: each file is its own group (as `loadfile` did: its
+# module fixtures made once), except the files in SHARED, which share a session fixture too expensive to make on both
+# workers. Groups are handed out heaviest first (FIRST, measured on 2026-11-26), then the rest in collection order,
+# so that a long file does not start last and leave one worker idle at the end; the order only decides when a
+# file runs, never what it runs.
+SHARED = {"tests/test_pipeline.py": "default_campaign",  # default_campaign_dir and default_modal
+          "tests/measure/test_modal.py": "default_campaign"}
+FIRST = ("default_campaign", "tests/workflow/test_mechanics.py", "tests/discrepancy/test_select.py",
+         "tests/workflow/test_calibration.py", "tests/workflow/test_snakefile.py", "tests/validate/test_assembly.py",
+         "tests/workflow/test_modal_stage.py", "tests/discrepancy/test_stage.py", "tests/calibrate/test_readouts.py",
+         "tests/workflow/test_input_mistakes.py", "tests/measure/test_coil.py")
+
+
+@pytest.hookimpl(tryfirst=True)  # before xdist's own hook reads the xdist_group marks
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    def group(item: pytest.Item) -> str:
+        mark = item.get_closest_marker("xdist_group")
+        if mark is not None:
+            return str(mark.args[0] if mark.args else mark.kwargs.get("name", "default"))
+        path = item.nodeid.split("::", 1)[0]
+        return SHARED.get(path, path)
+
+    for item in items:
+        if item.get_closest_marker("xdist_group") is None:
+            item.add_marker(pytest.mark.xdist_group(group(item)))
+    rank = {name: i for i, name in enumerate(FIRST)}
+    items.sort(key=lambda item: rank.get(group(item), len(FIRST)))  # stable: the rest keep their order

@@ -144,9 +144,3 @@ def test_bad_input_is_one_sentence_naming_the_file(workdir):
     assert (f"results/modal/first/{mode}/modal_properties.csv: all 12 runs of assembly 'first' are flagged unusable"
             in res.stderr), res.stderr
     assert "Traceback" not in (workdir / "results" / "logs" / "calibrate" / "first" / f"{mode}.log").read_text()
-
-
-def test_lint_reports_only_the_expected_conda_advice(workdir):
-    res = snakemake(workdir, "--lint")
-    items = [line.strip() for line in (res.stdout + res.stderr).splitlines() if line.strip().startswith("* ")]
-    assert set(items) <= {"* Specify a conda environment or container for each rule.:"}, res.stdout + res.stderr

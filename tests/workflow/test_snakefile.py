@@ -118,6 +118,8 @@ def test_missing_manifest_is_one_clear_line(workdir, tmp_path):
 
 
 def test_lint_reports_only_the_expected_conda_advice(workdir, small_campaign, tmp_path):
+    """`snakemake --lint` of the whole workflow: every rule file (the calibrate, posterior and summary rules that
+    test_calibration.py runs on their own among them) draws only the conda advice."""
     res = snakemake(workdir, "--lint", "--config", f"raw_data={small_campaign}", f"results={tmp_path / 'r'}")
     items = [line.strip() for line in (res.stdout + res.stderr).splitlines() if line.strip().startswith("* ")]
     assert items, res.stdout + res.stderr  # snakemake --lint always asks for conda (STYLE.md trap 4)
