@@ -1,7 +1,7 @@
 """A virtual shaker lab: campaigns in the raw-data contract from a known truth.
 
 `generate(spec, out_dir, truth_path)` simulates every run of the spec's test series
-(sweeps; dwells and ring-downs, `jointcal.synth.steady`) with the exact-Iwan simulator
+(sweeps; dwells and ring-downs, `jointcal.synth.dwell` and `jointcal.synth.ringdown`) with the exact-Iwan simulator
 (plus the hidden effect, if any), passes both channels through the measurement chain
 (`jointcal.synth.daq`), and writes the campaign (manifest + one file per run) and, separately, the truth: parameters, effect
 and per run the harmonic-balance steady-state resonance at that level.
@@ -21,16 +21,16 @@ from ..effects import EFFECTS
 from ..io import write_csv_atomic, write_json_atomic, write_run
 from ..models import resonance_amplitude, simulate
 from ..units import G
-from . import daq
+from . import daq, dwell, ringdown
 from .hidden import effect_defaults, run_model
 from .non_masing import KEY, share_of, with_share
 from .rig_truth import rig_truth
 from .shaker import Shaker, StructureMode, simulate_rig
 from .spec import JOINT_KEYS, RIG_LEVEL, load_spec
-from .steady import STEADY_PRIVATE, plan_steady, steady_band
 
 __all__ = ["generate", "plan_runs"]
 
+PLANS = {"dwell": dwell.plan, "ringdown": ringdown.plan}  # a test kind's series item -> its manifest rows
 _RANGES_G = (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000)
 
 
@@ -51,7 +51,10 @@ def plan_runs(spec: dict) -> pd.DataFrame:
         seq = 0
         for item in spec["series"]:
             if item.get("test", "sweep") != "sweep":  # dwells or ring-downs: one run per drive frequency
-                seq = plan_steady(rows, item, assembly, seq, ref, float(spec["sample_rate_hz"]), spec["file_format"])
+                if item["test"] not in PLANS:
+                    raise ValueError(f"series item {item}: test must be sweep, dwell or ringdown.")
+                seq = PLANS[item["test"]](rows, item, assembly, seq, ref, float(spec["sample_rate_hz"]),
+                                          spec["file_format"])
                 continue
             for _ in range(item.get("repeats", 1)):
                 for direction in item.get("directions", ["up", "down"]):
@@ -146,7 +149,7 @@ def generate(spec: dict | str | os.PathLike, out_dir: str | os.PathLike, truth_p
         # base: the controller holds the base acceleration (ripple); a rig's amplifier is open loop
         swept = getattr(row, "test", "sweep") == "sweep"
         f0, f1, rate, tail = ((row.f_start_hz, row.f_stop_hz, row.sweep_rate_hz_per_s, sw["tail_s"])
-                              if swept else steady_band(row))
+                              if swept else dwell.drive_band(row))
         # a dwell's drive is cut off, not ramped down: its ring-down starts from the steady state
         t, f_inst, drive = daq.controlled_sweep(fs_sim, f0, f1, rate, level, rng=run_rng,
                                                 ramp_s=sw["ramp_s"] if swept else 0.0,
@@ -177,7 +180,7 @@ def generate(spec: dict | str | os.PathLike, out_dir: str | os.PathLike, truth_p
         lev = {"level_g": row.level_g} if ref == "base" else {}
         truth_rows.append(dict(run_id=row.run_id, assembly=row.assembly, sequence=row.sequence,
                                **lev, direction=row.direction, **ranges, **extra))
-    manifest = plan.drop(columns=[c for c in STEADY_PRIVATE if c in plan])
+    manifest = plan.drop(columns=[c for c in dwell.PRIVATE if c in plan])
     if "dwell_hz" in manifest and manifest["dwell_hz"].isna().all():  # ring-downs only: no empty last column
         manifest = manifest.drop(columns=["dwell_hz"])
     write_csv_atomic(manifest.drop(columns=["level_V"]) if ref == "force" else manifest, out_dir / "manifest.csv")

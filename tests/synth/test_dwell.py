@@ -1,5 +1,5 @@
-"""The virtual lab's dwells and ring-downs (jointcal.synth.steady) through ingest and the modal stage's read-out,
-against the exact joint's first-harmonic balance: the Ministack (base-driven, closed-loop ripple 1%, distortion
+"""The virtual lab's dwells and ring-downs (jointcal.synth.dwell, jointcal.synth.ringdown) through ingest and the
+modal stage's read-out, against the exact joint's first-harmonic balance: the Ministack (base-driven, closed-loop ripple 1%, distortion
 0.3%/0.2%, noise 0.1% of each channel's rms, 24-bit DAQ with its anti-alias filter)."""
 from __future__ import annotations
 

@@ -1,39 +1,43 @@
-"""The virtual lab's dwells and ring-downs: a series item ``{test: dwell | ringdown, dwell_hz: [...], ...}``.
+"""The virtual lab's dwells: a series item ``{test: dwell, dwell_hz: [...], ...}``.
 
 A series item with ``test: dwell`` makes one run per frequency of ``dwell_hz`` (Hz): the drive held
 at that frequency for ``dwell_s`` (s, default 1.0) with the controller's ripple and the shaker's
 distortion, switched on and cut to zero without the sweep's ramps (a ramp-down would take the
 response down with the drive, quasi-statically: a 2 g Ministack dwell ramped down over 0.05 s
-leaves 0.22 g of its 50 g to ring down), then cut to zero and ``decay_s`` (s, default 0.5) of free
-decay recorded (`jointcal.io.test_kind` ``dwell``: the steady point and the ring-down). With
-``test: ringdown`` the same record is a ``ringdown`` run, its manifest naming no frequency. The
-drive is `jointcal.synth.daq.controlled_sweep` over a band of `TINY` of the frequency, so the
-measurement chain is the sweeps'.
+leaves 0.22 g of its 50 g to ring down), then ``decay_s`` (s, default 0.5) of free decay recorded
+(`jointcal.io.test_kind` ``dwell``: the steady point and the ring-down). The drive is
+`jointcal.synth.daq.controlled_sweep` over a band of `TINY` of the frequency (`drive_band`), so the
+measurement chain is the sweeps'. A ring-down (`jointcal.synth.ringdown`) is the same record.
 """
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["plan_steady", "steady_band", "STEADY_PRIVATE", "TINY"]
+__all__ = ["plan", "drive_band", "PRIVATE", "TINY"]
 
 TINY = 1e-9  # the dwell's relative band: one frequency, the sweep's drive generator
-STEADY_PRIVATE = ("drive_hz", "dwell_s", "decay_s")  # plan columns the manifest does not show
-KINDS = ("dwell", "ringdown")
+PRIVATE = ("drive_hz", "dwell_s", "decay_s")  # plan columns the manifest does not show
 
 
-def plan_steady(rows: list[dict], item: dict, assembly: str, seq: int, ref: str, fs: float, fmt: str) -> int:
-    """Append one manifest row per frequency of a dwell or ring-down series `item`; return the last sequence.
+def plan(rows: list[dict], item: dict, assembly: str, seq: int, ref: str, fs: float, fmt: str) -> int:
+    """Append one manifest row per frequency of a dwell series `item`; return the last sequence.
 
     Raises
     ------
     ValueError
-        A ``test`` other than dwell or ringdown, no ``dwell_hz``, or a frequency at or above Nyquist.
+        No ``dwell_hz``, or a frequency at or above Nyquist.
     """
+    return held_drive_rows(rows, item, assembly, seq, ref, fs, fmt, "dwell")
+
+
+def held_drive_rows(rows: list[dict], item: dict, assembly: str, seq: int, ref: str, fs: float, fmt: str,
+                    kind: str) -> int:
+    """Rows of a held drive cut off into its free decay, one per frequency of ``dwell_hz``: a ``dwell`` names its
+    frequency in the manifest, a ``ringdown`` does not."""
     from .spec import RIG_LEVEL
 
-    kind = item["test"]
     freqs = [float(f) for f in np.atleast_1d(item.get("dwell_hz", []))]
-    if kind not in KINDS or not freqs or not all(0 < f < fs / 2 for f in freqs):
+    if not freqs or not all(0 < f < fs / 2 for f in freqs):
         raise ValueError(f"series item {item}: test must be dwell or ringdown with dwell_hz a list of frequencies "
                          f"between 0 and Nyquist ({fs / 2:g} Hz).")
     key = RIG_LEVEL[ref]
@@ -51,7 +55,7 @@ def plan_steady(rows: list[dict], item: dict, assembly: str, seq: int, ref: str,
     return seq
 
 
-def steady_band(row) -> tuple[float, float, float, float]:
+def drive_band(row) -> tuple[float, float, float, float]:
     """(f_start, f_stop, rate, tail_s) of the drive generator for a planned dwell or ring-down row."""
     f = float(row.drive_hz)
     return f, f * (1 + TINY), f * TINY / float(row.dwell_s), float(row.decay_s)
