@@ -153,12 +153,12 @@ def main():
             continue
         for ref in a.ref.split(","):
             for seed in map(int, a.seeds.split(",")):
+                hidden = name + ("+" + params["also"]["name"] if "also" in params else "")
                 with tempfile.TemporaryDirectory() as d:
                     diag, wall = diagnose_campaign(specs_of(name, params, ref, seed), Path(d))
-                    if a.keep:
+                    if a.keep:  # one folder per case: the pair's apart from its first effect's
                         import shutil
-                        shutil.copytree(d, Path(a.keep) / f"{name}_{ref}_{seed}", dirs_exist_ok=True)
-                hidden = name + ("+" + params["also"]["name"] if "also" in params else "")
+                        shutil.copytree(d, Path(a.keep) / f"{hidden}_{ref}_{seed}", dirs_exist_ok=True)
                 line = (f"{hidden:36s} {ref:8s} seed {seed}: {diag['effect']:36s} {diag['confidence']:6s} "
                         f"E {diag['metric_before']:6.2f} -> {diag['metric_after']:5.2f} "
                         f"({(diag['metric_after'] / diag['metric_before'] - 1) * 100:+4.0f}%) "
