@@ -4,7 +4,8 @@
    time simulation of it on the same runs and bins (`floor.fast_floor`).
    A voltage drive: the slope of its modal constant A(w) refit with the baseline on the
    envelope frames (`drive.refine_slope`: the read-out's leaves most of the coil's phase
-   slope out); every later step takes the refined drive.
+   slope out); every later step takes the refined drive, and a named model refits it once
+   more before its recalibration (the baseline's misfit moves the slope it finds).
 1. Localise: the baseline (the calibration's optimum, refit on the envelopes) against
    the measured envelopes; residual map and fingerprints (`fingerprints`).
 2. Candidates: the baseline and every library effect (`jointcal.effects.library()`), each refit on
@@ -162,6 +163,14 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     decision = decide(scored, outside, floor=F)
     effect, confidence, ranked = decision.effect, decision.confidence, decision.ranked
     named = next((s for s in ranked if s.name == effect), None)
+    if drive is not None and named is not None:  # the slope again, with the model kept (the baseline's misfit moved it)
+        gain, runs, again = refine_slope(candidate(named.name, space, m, scales), named.fit.theta, gain, build,
+                                         max_nfev=settings.max_nfev)
+        rows = [{**r, "drive_gain": gain} for r in rows]
+        drive["with_named"] = {"model": named.name, **again}
+        say(f"{assembly}: the voltage drive's slope refit with {named.name}: "
+            f"{complex(*again['relative_slope_refined']):.3f}, its E {again['baseline_E_read_out']:.2f} -> "
+            f"{again['baseline_E_refined']:.2f}")
     final, cf, rec, n_fits = _recalibrated(assembly, named if named is not None else base, space, m, runs,
                                            joint_starts, settings, say, scales)
     clock.lap("recalibrate")
