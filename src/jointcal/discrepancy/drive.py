@@ -19,9 +19,11 @@ and the slope's real and imaginary parts by linear least squares of the weighted
 revalidation then take the refined A(w); the fast model's floor is taken before, with the
 read-out's, as the validation's simulation was driven. A baseline that misses (an effect hidden)
 moves the slope it finds (on the jointed beam with elastic softening: -0.061i against the rig's
--0.090i, relative); so a named model refits it once more, from its own fit, before its
-recalibration (-0.090i, and the loss ratio 0.37 -> 0.31, truth 0.30). `refine_slope` takes any
-candidate.
+-0.090i, relative; cubic stiffening hidden: +0.030-0.140i, and the cubic's held-out score 2.8).
+So when a candidate scores better than the baseline, the slope is refit with it and the library
+scored again; and a named model refits it once more, from its own fit, before its recalibration
+(elastic softening: -0.090i, and the loss ratio 0.37 -> 0.31, truth 0.30). `refine_slope` takes
+any candidate.
 
 A force at the driving point is 1/m by physics (real, no slope, `jointcal.measure.sweepfit`):
 its drive is left as the read-out gives it.
