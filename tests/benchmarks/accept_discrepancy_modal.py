@@ -71,7 +71,16 @@ joint_settling's baseline finds +0.078-0.095i, moved by the drift it misses):
     cubic_stiffening                     voltage  seed 1: cubic_stiffening                     high   E   9.12 ->  0.65 ( -93%)  floor 0.18, stage 222 s
     joint_settling                       voltage  seed 1: unexplained                          low    E   4.32 ->  2.24 ( -48%)  floor 0.18, stage 133 s
 
-neighbour_mode, channel_delay, the elastic+cubic pair and contact_spring (voltage) not rerun. The force rows none,
+Two more voltage rows with this code, end to end (new campaigns, seed 1, same machine):
+
+    channel_delay                        voltage  seed 1: none                                 high   E   4.21 ->  0.86 ( -79%)  floor 0.18, stage 167 s
+    contact_spring                       voltage  seed 1: unexplained                          low    E  16.61 ->  7.75 ( -53%)  floor 0.22, stage 154 s
+
+channel_delay is wrong: on a voltage drive the read-out's complex modal constant takes the delay's phase at
+resonance (-w_c tau) and the refit slope the rest (A' w_c / A_c -0.005-0.330i against the coil's -0.09i), so the
+baseline with the refit drive reproduces the runs (held-out 1.23) and the time check does not contradict it. A
+coil turning the phase that far would also tilt |A(w)| (real part about -0.1, here -0.005): a fingerprint of a delay
+on a voltage rig, not used yet. neighbour_mode and the elastic+cubic pair (voltage) not rerun. The force rows none,
 elastic_softening and cubic_stiffening rerun on this branch (seed 1, same machine; started before its last two
 commits, which touch only voltage campaigns: a force run's level is its measured force, no two alike) are unchanged: none high
 0.59 -> 0.58 floor 0.25 (267 s); elastic_softening high 8.87 -> 0.70 floor 0.35 (365 s); cubic_stiffening high
