@@ -54,6 +54,21 @@ def test_a_bin_without_repeats_never_takes_another_bins_scatter():
     assert scale["sigma_mag_db"].iloc[0] < 0.06 and scale["sigma_mag_db"].iloc[2] > 0.5
 
 
+def test_two_sweep_rates_at_one_level_are_not_repeats():
+    """Two runs at one level and direction, swept at two rates whose curves differ near resonance (the faster
+    one's peak 0.5% higher: its transient), 0.2 dB and 1 deg of noise: their scale is that noise (within
+    15%), not their difference; the same two runs at one rate are repeats, and the difference shows."""
+    rng = np.random.default_rng(7)
+    slow, fast = _frames(rng, 0.2, 1.0, n=1200), _frames(rng, 0.2, 1.0, f0=1.005 * F0, n=1200)
+    m = _metrics(["slow", "fast"], [1.0, 1.0], ["up", "up"])
+    scale = repeat_scatter({"slow": slow, "fast": fast}, m.assign(sweep_rate_hz_per_s=[1.0, 4.0]))
+    assert (scale["source"] == "own noise").all()
+    assert np.allclose(scale["sigma_mag_db"], 0.2, rtol=0.15), scale
+    assert np.allclose(scale["sigma_phase_deg"], 1.0, rtol=0.15), scale
+    same = repeat_scatter({"slow": slow, "fast": fast}, m.assign(sweep_rate_hz_per_s=[1.0, 1.0]))
+    assert (same["source"] == "repeats").all() and same["sigma_phase_deg"].iloc[0] > 3 * 1.0
+
+
 def test_e_of_a_biased_model_grows_with_the_own_noise_scale():
     """A 0.3 dB bias against runs of 0.1 dB own noise: E_mag = 3, outside the runs' own noise."""
     rng = np.random.default_rng(5)

@@ -40,7 +40,20 @@ def _floor(d: Mapping) -> str:
             + ("well below the repeat scatter, so the held-out scores measure the model, not the fast model."
                if fl["E"] <= 0.5 else "a share of the scores above is the fast model's own; the decision takes it out "
                "of the baseline's score." if fl["E"] <= FLOOR_HIGH else
-               "as large as the repeat scatter: the confidence is capped at medium."))
+               "as large as the repeat scatter: the confidence is capped at medium.")) + _drive(d)
+
+
+def _drive(d: Mapping) -> str:
+    """A voltage drive's slope refit (`drive.refine_slope`), in a sentence ('' when none was)."""
+    v = d.get("voltage_drive")
+    if not v or v["slope_refined"] == v["slope_read_out"]:
+        return ""
+    a, b = complex(*v["relative_slope_read_out"]), complex(*v["relative_slope_refined"])
+    return (f" The voltage drive's modal constant changes across the band by A' w_c / A_c = {b.real:.3f}{b.imag:+.3f}i "
+            f"per unit w / w_c, not the read-out's {a.real:.3f}{a.imag:+.3f}i (the coil's phase, which the "
+            "read-out's narrow window leaves out): refit with the baseline (its E "
+            f"{v['baseline_E_read_out']:.2f} -> {v['baseline_E_refined']:.2f}), every candidate and the E after "
+            "take it.")
 
 
 def _named(d: Mapping, E0: float, E1: float) -> list[str]:

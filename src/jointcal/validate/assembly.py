@@ -100,6 +100,7 @@ def _one_run(model: MinistackModel, record: pd.DataFrame, row: dict, draws: Sequ
         return pd.DataFrame(), {**run_head(row), "n_frames": 0, "note": str(exc)}, None
     t1 = time.perf_counter()
     frames, metrics = compare_run(env_m, props_m, env_s, props_s, band=s.band)
+    metrics = {**{k: v for k, v in run_head(row).items() if k not in metrics}, **metrics}  # the manifest's sweep rate
     trace = None
     if reference_column(record) != "base_accel_g" and np.isfinite(metrics.get("f_res_meas_hz", np.nan)):
         trace = time_envelopes(record, sim_record, metrics["f_res_meas_hz"], float(row["sample_rate_hz"]))

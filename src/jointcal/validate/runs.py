@@ -43,12 +43,12 @@ __all__ = ["clean_base", "reference_column", "drive_gain", "model_input", "simul
            "compare_run", "measure_pair", "time_envelopes", "draw_transmissibility"]
 
 
-HEAD = ("run_id", "assembly", "sequence", *LEVEL.values(), "direction")
+HEAD = ("run_id", "assembly", "sequence", *LEVEL.values(), "direction", "sweep_rate_hz_per_s")
 
 
 def run_head(row: Mapping) -> dict:
-    """A run's identity for the tables: run_id, assembly, sequence, its level column, direction, and
-    ``level``, the level in its own unit (g, lbf or V) whatever the reference."""
+    """A run's identity for the tables: run_id, assembly, sequence, its level column, direction, sweep rate
+    (when the row has it), and ``level``, the level in its own unit (g, lbf or V) whatever the reference."""
     head = {k: row[k] for k in HEAD if k in row}
     head["level"] = float(row[level_column(row)]) if level_column(row) else np.nan
     return head
