@@ -38,10 +38,10 @@ import pandas as pd
 from ..io.contract import LEVEL, REFERENCE, RESPONSE, UNUSABLE, excitation_kind
 from ..io._kinds import kind_of
 from .envelopes import ENVELOPE_COLUMNS
-from .forced_decay import Receptance, flank_receptance
 from .frf import displacement_ratio, h1_estimate
 from .modal import modal_properties
 from .modes import mode_name, modal_peaks, track_modes
+from .receptance import Receptance, flank_receptance
 from .testkinds import other_kinds_modal
 
 __all__ = ["campaign_modal", "run_peaks", "assembly_coil"]
