@@ -2,7 +2,8 @@
 (jointcal.measure.forced_decay) by the modal stage with the modal constant and residual receptance its own sweep
 measured (jointcal.measure.receptance), against the exact joint's first-harmonic balance of the structure alone:
 the jointed beam of tests/_support/rigs.py (exact Iwan, a 230 Hz second mode, its small open-loop shaker; noise
-0.1% of each channel's rms)."""
+0.1% of each channel's rms). Its open-loop dwells, each at the force it measured (a level each), are read with
+the same measured modal constant and receptance."""
 from __future__ import annotations
 
 import numpy as np
@@ -24,13 +25,16 @@ def lab(tmp_path_factory):
     levels = rigs.levels_V()
     f_low, z_low = rigs.truth_curve("force", rigs.Q_TARGETS[0])
     f_top, _ = rigs.truth_curve("force", rigs.Q_TARGETS[2])
+    f_mid, z_mid = rigs.truth_curve("force", rigs.Q_TARGETS[1])
     rate = 2.0 * (f_low * z_low) ** 2  # eta 2 at the lowest level
     generate({"seed": 5, "sample_rate_hz": 2048.0, "measurement": {"noise_fraction": 1e-3},
               "sweep": {"f_start_hz": 0.7 * f_low, "f_stop_hz": 1.3 * f_low, "rate_hz_per_s": rate,
                         "ramp_s": 0.05, "tail_s": 1.5},
               "series": [{"level_V": levels[0], "directions": ["up"]},
                          {"level_V": levels[2], "test": "ringdown", "dwell_hz": [round(f_top, 3)], "dwell_s": 1.5,
-                          "decay_s": 2.5}],
+                          "decay_s": 2.5},
+                         {"level_V": levels[1], "test": "dwell", "dwell_s": 1.5, "decay_s": 2.5,
+                          "dwell_hz": [round(f_mid * (1 + k * z_mid), 3) for k in (-1.0, 1.0)]}],
               "assemblies": {"beam": rigs.JOINTED_BEAM},
               "rig": {"reference": "force", "shaker": rigs.SMALL_SHAKER, "second_mode": rigs.SECOND_MODE}},
              folder / "campaign", folder / "truth.json")
@@ -70,3 +74,15 @@ def test_its_sweep_measured_what_the_read_needs(lab):
     sweep = table[table["f_res_method"] == "sweep_fit"].iloc[0]
     model, _, _ = rigs.rig()
     assert abs(sweep["modal_constant_re"] * model.m - 1) < 0.01
+
+
+def test_each_open_loop_dwell_reads_its_own_point_with_the_sweeps_constant(lab):
+    # an open-loop force-referenced dwell's manifest level is the force it measured: a level per dwell, too few for
+    # the modal constant's fit (before: few_dwells, unusable); read with the sweep's A and R each dwell gives the
+    # structure's f and zeta at its amplitude (issue 31's dwell line, 0.05% / 2%)
+    table, bb = lab
+    dw = table[table["test"] == "dwell"]
+    assert len(dw) == 2 and not dw["flags"].str.contains("few_dwells|unusable").any()
+    f_t, z_t = np.array([rigs.truth_curve("force", q) for q in dw["q_in"]]).T
+    assert np.abs(dw["f_res_hz"] / f_t - 1).max() < 5e-4 and np.abs(dw["zeta_res"] / z_t - 1).max() < 0.02
+    assert len(bb[bb["test"] == "dwell"]) == 2

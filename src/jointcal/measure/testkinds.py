@@ -16,7 +16,10 @@ The runs of the other test kinds (`jointcal.io.test_kind`), in the order data fl
    (``through_force``), or not read where no sweep measured them (``shaker_on``).
 3. **Dwell points** (`jointcal.measure.dwell`): each dwell's steady point; a level's dwells (three
    or more per assembly, mode and level) give the modal constant and so each dwell's natural
-   frequency and damping at the amplitude it reached, and the level's phase resonance.
+   frequency and damping at the amplitude it reached, and the level's phase resonance. Force-referenced,
+   where the mode's sweep measured its modal constant and the other modes' receptance R
+   (`jointcal.measure.receptance`), each dwell's X - R is read with that constant, however few dwells
+   a level holds: an open-loop rig's manifest level is the force each dwell measured, one per dwell.
 
 Each run keeps one row in modal_properties.csv (a ring-down's largest-amplitude window, a dwell's
 point), ``f_res_method`` naming the read-out, so the later stages read it like a sweep's.
@@ -186,18 +189,25 @@ def other_kinds_modal(rows: list[dict], records: dict, kind: str, swept: dict[st
     for r in reads:
         if r["point"] is not None:
             dwells.setdefault((r["mode"], float(r["row"][level])), []).append(r)
-    for group in dwells.values():
+    for (mode, _), group in dwells.items():
         pts = [r["point"] for r in group]
-        if len(pts) < 3:  # no modal constant: the points' frequencies and damping cannot be read
+        rc = (receptance or {}).get(swept.get(mode)) if kind == "force" else None
+        if len(pts) < 3 and rc is None:  # no modal constant: the points' frequencies and damping cannot be read
             nan = float("nan")
             for r in group:
                 r["dwell"] = {"q_in": r["point"]["q_in"], "f_hz": nan, "zeta": nan,
                               "fit": {"f_hz": nan, "zeta": nan, "q_in": nan, "residual": nan, "flags": ["few_dwells"]}}
             continue
-        fit = dwell_mode(np.array([p["f_hz"] for p in pts]), np.array([p["X"] for p in pts]),
-                         np.array([p["q_in"] for p in pts]), A=-G if kind == "base" else None)
-        for r, (q, f, z) in zip(group, fit["points"]):
-            r["dwell"] = {"q_in": q, "f_hz": f, "zeta": z, "fit": fit}
+        f = np.array([p["f_hz"] for p in pts])
+        X, q, A = np.array([p["X"] for p in pts]), np.array([p["q_in"] for p in pts]), -G if kind == "base" else None
+        if rc is not None:  # the mode's modal constant and the other modes' receptance, measured by its sweep
+            X = X - np.array([rc.residual(v) for v in f])
+            q, A = np.abs(X) * np.array([p["ref_amp"] for p in pts]), rc.modal_constant
+        fit = dwell_mode(f, X, q, A=A)
+        if rc is not None and len(pts) == 1:  # A measured: nothing fitted, the one point is its own read-out
+            fit["flags"] = []
+        for r, (qi, fi, zi) in zip(group, fit["points"]):
+            r["dwell"] = {"q_in": qi, "f_hz": fi, "zeta": zi, "fit": fit}
     modal, points = [], []
     for r in reads:
         row, rid = r["row"], r["row"]["run_id"]
