@@ -57,9 +57,9 @@ def test_the_ring_down_reads_the_structures_backbone_through_the_force(lab):
     table, bb = lab
     row = table[table["test"] == "ringdown"].iloc[0]
     assert "through_force" in row["flags"] and "unusable" not in row["flags"]  # before: shaker_on, not read
-    rd = bb[bb["test"] == "ringdown"]
+    rd = bb[(bb["test"] == "ringdown") & (bb["run_id"] == row["run_id"])]  # (the dwells' own decays are read too)
     f_t, z_t = np.array([rigs.truth_curve("force", q) for q in rd["q_in"]]).T
-    # issue 31's lines (0.1%, 3%, 1.5 decades; here 1.74 decades, f within 0.021%, zeta within 1.8%); the decay
+    # issue 31's lines (0.1%, 3%, 1.5 decades; here 1.92 decades, f within 0.025%, zeta within 2.2%); the decay
     # itself rings at the rig's pole, 2.4% below
     assert np.log10(rd["q_in"].max() / rd["q_in"].min()) >= 1.5
     assert np.abs(rd["f_hz"] / f_t - 1).max() < 1e-3 and np.abs(rd["zeta"] / z_t - 1).max() < 0.03
