@@ -25,9 +25,9 @@ zeta = sigma / wn. The modes outside the band add their flexibility at the drivi
 (R the residual receptance, in/lbf), so `residual` is taken off H first; the structure's coordinate is then
 x = X_measured - R P. A is what a dwell's or a sweep's force-referenced fit calls the modal constant
 (`jointcal.measure.dwell.dwell_mode`, `jointcal.measure.sweepfit.SweepFit.modal_constant`): it must come
-from the same campaign, as must R (`jointcal.measure.receptance`). Its error enters through the force's share only: |A P / X| is about m_a / m of
-|s|^2 (the armature's mass over the mode's), so 1% in A moves wn by about m_a / (2 m) % and zeta by the
-shaker's share of the coupled damping times 1%.
+from the same campaign, as must R (`jointcal.measure.receptance`). Its error enters through the force's
+share only: |A P / X| is about m_a / m of |s|^2 (the armature's mass over the mode's), so 1% in A moves wn
+by about m_a / (2 m) % and zeta by the shaker's share of the coupled damping times 1%.
 
 The damping is read as viscous at the window's frequency w. A joint's quadrature force is rate independent
 (a hysteretic loss h: Im(m Y) = c w + h), so where w lies below wn (the rig's pole below the structure's)
@@ -57,9 +57,10 @@ The read-out, in the order data flows:
    s from the response alone: the joint fit had read its zeta 3.6% high), and each window reads the fitted K
    at its s. The force's noise then averages over
    the decay, and the read goes as far down as the decay rate is known (on the virtual beam, with the
-   response alone fitting s, 1.6-1.75 decades where each window's own K had stopped at 1.2-1.7). ``K_chi2`` is the fit's mean squared normalised residual:
-   about 1 for a linear shaker (1.2 on the linear rig, 2.5 on the exact Iwan beam's, the first windows left
-   out); a shaker whose suspension or coil is not linear over the stroke shows above it.
+   response alone fitting s, 1.6-1.75 decades where each window's own K had stopped at 1.2-1.7).
+   ``K_chi2`` is the fit's mean squared normalised residual: about 1 for a linear shaker (1.2 on the linear
+   rig, 2.5 on the exact Iwan beam's, the first windows left out); a shaker whose suspension or coil is not
+   linear over the stroke shows above it.
 4. **The structure** (`structure_pole`) at each window's amplitude q_in = |X - R P|.
 
 Checked against closed forms (tests/measure/test_forced_decay.py): the coupled rig's eigenvector gives the
@@ -68,9 +69,9 @@ shaker (armature, suspension, coil; with and without a 230 Hz second mode), dwel
 f within 0.016%, zeta within 1.7% over 1.79-1.81 decades (read as a free decay: the rig's pole, 2.3% low);
 the exact Iwan beam on its shaker (rigs.py's top level): f within 0.017%, zeta within 1.3% (mean +0.6%: the
 joint's share read at the rig's frequency, above) of the structure's first-harmonic balance over 1.71
-decades, A = 1/m and R the second mode's there. In a virtual force campaign (tests/synth/test_forced_ringdown.py)
-with A and R measured by its own lowest-level sweep (A 0.29% low): 1.92 decades, f within 0.025%, zeta 2.2%. Read in a campaign with A and R measured by its sweeps
-(`jointcal.measure.receptance`; tests/benchmarks/accept_testkinds.py).
+decades, A = 1/m and R the second mode's there. In a virtual force campaign, A and R measured by its own
+lowest-level sweep (`jointcal.measure.receptance`; A 0.29% low; tests/synth/test_forced_ringdown.py): 1.92
+decades, f within 0.025%, zeta within 2.2%; over three seeds, tests/benchmarks/accept_testkinds.py.
 """
 from __future__ import annotations
 
@@ -90,8 +91,8 @@ ZETA_SE_LIVE = (3 * ZETA_SE_MAX - 0.006) / 3  # zeta's standard error within thi
 # three standard errors within 3%, less the +0.6% bias of a joint's share read at the rig's frequency (0.8%)
 OUTLIER = 4.0  # a window's K this many standard errors off the fit over the decay is left out of it
 SETTLE_LIVE = 3.0  # periods after the decay's start left out: the start found from the response's plateau lies
-# up to half a period before the cut (4.4 ms at 97 Hz on the virtual beam), and the coil's current and the DAQ
-# filter ring in the force for a period after it
+# up to half a period before the cut (4.4 ms at 97 Hz on the virtual beam), and the force is not the shaker's
+# reaction alone for a period or two after it (at 2 periods the first window's zeta read up to 4% off)
 
 COLUMNS = ["t_s", "window_s", "q_in", "f_hz", "zeta", "zeta_se", "f_rig_hz", "zeta_rig", "force_share", "K_chi2",
            "misfit", "flags"]
@@ -255,9 +256,11 @@ def forced_decay_backbone(response_g: ArrayLike, force_lbf: ArrayLike, fs: float
         raise ValueError(f"the response ({x.size} samples) and the force ({F.size}) must be one record's channels.")
     A = complex(modal_constant)
     if not (np.isfinite(A) and A != 0):
-        raise ValueError(f"the modal constant must be a finite, nonzero number ((in/s^2) per lbf), got {modal_constant!r}.")
+        raise ValueError(f"the modal constant must be a finite, nonzero number ((in/s^2) per lbf), "
+                         f"got {modal_constant!r}.")
     if not (np.isfinite(f_hz) and 0 < f_hz * (1 + BAND) < fs / 2):
-        raise ValueError(f"the mode's frequency {f_hz!r} Hz must lie below the record's Nyquist frequency {fs / 2:g} Hz.")
+        raise ValueError(f"the mode's frequency {f_hz!r} Hz must lie below the record's Nyquist frequency "
+                         f"{fs / 2:g} Hz.")
     if start is None:
         sos = signal.butter(4, [f_hz * (1 - BAND), f_hz * (1 + BAND)], btype="bandpass", fs=fs, output="sos")
         start = decay_start(fs, signal.sosfiltfilt(sos, x - np.median(x)), F - np.median(F))
