@@ -1,6 +1,6 @@
 """Acceptance of the ring-down and dwell read-outs on the virtual lab (issue 31): one truth, three kinds of test.
 
-Run:  python tests/benchmarks/accept_testkinds.py [--seeds 1,2,3] [--out FILE]
+Run:  python tests/benchmarks/accept_testkinds.py [--seeds 1,2,3] [--out FILE] [--rigs 'beam force,...']
 
 For each rig -- the jointed beam of `tests/_support/rigs.py` (100 Hz, its Iwan joint, a second linear mode at
 230 Hz, on its small open-loop shaker) with a force and with a voltage reference, and the base-driven Ministack
@@ -20,26 +20,32 @@ ring-downs' at its amplitude (a line in log q through the windows within a facto
 Acceptance (issue 31): ring-down f within 0.1%, zeta within 3% over >= 1.5 decades; dwells within 0.05% / 2%;
 the kinds on one backbone within 0.1%.
 
-Measured 2026-11-26, seeds 1-3, loaded 2-core machine (worst over every decay window: the ring-down run's and the
-five dwells' own decays; %):
+Measured 2026-11-26, seeds 1-3, loaded 2-core machine (load average 5-7; worst over every decay window: the
+ring-down run's and the five dwells' own decays; %):
 
     rig             ring-down run decades  decay f  decay zeta  dwell f   dwell zeta  sweep f  one backbone f
     beam voltage    1.54-1.66              0.031    1.5-2.2     0.0009    0.88        0.0076   0.0068
     ministack base  1.81-2.04              0.099-0.103  2.9-3.6  0.0011    0.11        0.0021   0.083
-    beam force      not read (shaker_on)   -        -           few_dwells            0.0077   -
+    beam force      1.51-1.56              0.028    1.9-2.4     0.0032    0.39        0.0077   0.018
 
 - Beam, voltage reference: every line met.
 - Ministack, base: f at the line (0.099-0.103%) and zeta over it in seed 2 (3.55%): the ring-down here starts at
   the 5 g level (tests/synth/test_steady.py's at 2 g reads within 0.062% / 2.9% over six seeds); its first
   windows sit where the joint's backbone bends most. NOT MET at 5 g.
-- Beam, force reference: NOT MET, by the rig's physics. After the voltage's cut the gauge goes on reading the
-  armature's reaction, and the decay rings at the coupled rig's pole, 2.4% below the structure's (within 0.02% of
-  the rig's pole, seed 1 before the flag): read as the structure's backbone it would put two backbones in one
-  campaign. Such a decay is now flagged ``shaker_on`` and not read. The dwells: an open-loop force-reference
-  dwell's manifest level is the force each dwell measured, a different level per frequency, so no level holds
-  the three dwells the modal constant's fit needs (``few_dwells``). Left open: a force-controlled stepped sine
-  (one force per level) would group; reading the decay through the measured force (the structure's dynamic
-  stiffness m s^2 + c s + k = A F / X at each window's complex frequency) would give the structure's own.
+- Beam, force reference: every line met (the decades thinly: 1.51 in seed 2; seeds 4-6, same day: 1.56-1.86
+  decades, decay f within 0.027%, zeta within 2.5%, dwells 0.0032% / 0.38%, one backbone 0.018%). After the voltage's cut the gauge
+  goes on reading the armature's reaction and the decay rings at the coupled rig's pole, 2.4% below the
+  structure's (``rd_vs_rig_pole_f_pct``: the read points against the rig's pole); each decay (flag
+  ``through_force``) is read through the measured force (`jointcal.measure.forced_decay`: the structure's
+  A / H(s) - s^2 = c' s + wn^2 at each window's s), with the modal constant of the lowest-level sweep's fit
+  (0.24% low of 1/m, seed 1) and the second mode's receptance from that sweep's FRF flanks
+  (`jointcal.measure.receptance`: 3.4% low): nothing of the truth. The decays' zeta holds a +0.5-0.6% mean
+  bias (the joint's rate-independent loss read at the rig's frequency, 2.4% below the structure's). The
+  open-loop dwells, one measured force level each (before: ``few_dwells``), are each read with the same A
+  and R: f within 0.0032%, zeta within 0.39% of the structure at their amplitude (``dwell f``/``dwell
+  zeta`` here: each dwell's own point, not a level's phase resonance). With zeta's standard error held at
+  1% as the ring-down's (instead of 0.8%, `forced_decay.ZETA_SE_LIVE`) the ring-down runs read 1.69-1.81
+  decades but one window in seed 3 read zeta 3.65% off.
 """
 from __future__ import annotations
 
@@ -133,7 +139,7 @@ def case(name: str, spec: dict, truth, folder: Path) -> dict:
     out["one_backbone_f_pct"] = 100 * worst
     out["decay_flags"] = ";".join(sorted(set(";".join(table.loc[table["test"] == "ringdown", "flags"].fillna(""))
                                              .split(";")) - {""}))
-    if name == "beam force" and len(rd):  # the shaker stays on after the cut: the decay is the coupled rig's
+    if name == "beam force" and len(rd):  # read through the force: the structure's, 2.4% off the coupled rig's pole
         model, sh, second = rigs.rig()
         f_r = np.array([rig_pole(model, sh, v, second)[0] for v in rd["q_in"]])
         out["rd_vs_rig_pole_f_pct"] = 100 * float(np.abs(rd["f_hz"].to_numpy() / f_r - 1).max())
@@ -144,6 +150,7 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--seeds", default="1")
     ap.add_argument("--out", default=None)
+    ap.add_argument("--rigs", default="beam force,beam voltage,ministack base")
     args = ap.parse_args()
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -151,6 +158,8 @@ def main() -> None:
             for name, (spec, truth) in (("beam force", _beam_spec("force", seed)),
                                         ("beam voltage", _beam_spec("voltage", seed)),
                                         ("ministack base", _ministack_spec(seed))):
+                if name not in args.rigs.split(","):
+                    continue
                 r = case(name, spec, truth, Path(tmp) / f"{name.replace(' ', '_')}_{seed}")
                 r["seed"] = seed
                 rows.append(r)

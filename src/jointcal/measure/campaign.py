@@ -41,6 +41,7 @@ from .envelopes import ENVELOPE_COLUMNS
 from .frf import displacement_ratio, h1_estimate
 from .modal import modal_properties
 from .modes import mode_name, modal_peaks, track_modes
+from .receptance import Receptance, flank_receptance
 from .testkinds import other_kinds_modal
 
 __all__ = ["campaign_modal", "run_peaks", "assembly_coil"]
@@ -153,14 +154,18 @@ def campaign_modal(runs: pd.DataFrame, load: Callable[[dict], tuple], modal_kw: 
             if len(tab):
                 frf.setdefault(out["run_id"], []).append(_independent_lines(tab, loaded[out["run_id"]]).assign(
                     mode=out["mode"]))
-    _other_kinds(others, rows, load, mode_hz, points)
+    _other_kinds(others, rows, load, mode_hz, points, frf)
     order = {r: i for i, r in enumerate(runs["run_id"])}
     rows.sort(key=lambda o: order.get(o["run_id"], -1))
     return rows, {r: pd.concat(t, ignore_index=True) for r, t in frf.items()}, notes
 
 
-def _other_kinds(others: list[dict], rows: list[dict], load: Callable, mode_hz, points: list | None) -> None:
-    """Append the dwell and ring-down runs' modal rows to `rows` and their backbone points to `points`."""
+def _other_kinds(others: list[dict], rows: list[dict], load: Callable, mode_hz, points: list | None,
+                 frf: dict | None = None) -> None:
+    """Append the dwell and ring-down runs' modal rows to `rows` and their backbone points to `points`.
+
+    A force-referenced assembly's decays are read through the force (`jointcal.measure.forced_decay`) with
+    each swept mode's `_receptance`."""
     for assembly, group in pd.DataFrame(others or [{"assembly": None}]).dropna(subset=["assembly"]).groupby(
             "assembly", sort=False):
         grows = group.to_dict("records")
@@ -168,14 +173,38 @@ def _other_kinds(others: list[dict], rows: list[dict], load: Callable, mode_hz, 
         first = next((v for v in records.values() if v is not None), None)
         kind = excitation_kind([*(first.columns if first is not None else []), *grows[0]])
         mine = [r for r in rows if r.get("assembly") == assembly and UNUSABLE not in str(r.get("flags", ""))]
-        swept = {}
+        swept, receptance = {}, {}
         for r in sorted(mine, key=lambda r: r.get(LEVEL[kind], np.inf)):
             if r.get("mode") and np.isfinite(r.get("f_res_hz", np.nan)):
                 swept.setdefault(r["mode"], float(r["f_res_hz"]))
-        modal, pts = other_kinds_modal(grows, records, kind, swept, mode_hz)
+                if kind == "force" and r["mode"] not in receptance:
+                    receptance[r["mode"]] = _receptance(r, (frf or {}).get(r["run_id"], []))
+        receptance = {swept[m]: v for m, v in receptance.items() if v is not None}
+        modal, pts = other_kinds_modal(grows, records, kind, swept, mode_hz, receptance=receptance)
         rows += modal
         if points is not None:
             points += pts
+
+
+EDGE = 0.03  # a sweep's FRF lines within this share of its band's edges are left out (the drive's ramps)
+
+
+def _receptance(row: dict, tables: list) -> Receptance | None:
+    """A force-referenced mode's `Receptance` from one swept run (its lowest level's): the swept-mode fit's
+    modal constant (``modal_constant_re``/``_im``) and the FRF's flanks (`flank_receptance`); None where the run
+    has no fit or its FRF too few flank lines."""
+    A = complex(row.get("modal_constant_re", np.nan), row.get("modal_constant_im", 0.0) or 0.0)
+    tab = next((t for t in tables if (t["mode"] == row["mode"]).all()), None)
+    if tab is None or not np.isfinite(A) or A == 0:
+        return None
+    f = tab["freq_hz"].to_numpy(float)  # the run's driven band (`jointcal.measure.frf.record_frf`)
+    lo, hi = f.min(), f.max()
+    inner = (f > lo + EDGE * (hi - lo)) & (f < hi - EDGE * (hi - lo))
+    try:
+        return flank_receptance(f[inner], (tab["x_re"] + 1j * tab["x_im"]).to_numpy()[inner], A,
+                                source=str(row["run_id"]))
+    except ValueError:
+        return None
 
 
 def assembly_coil(plan: list, loaded: dict, kw: dict, notes: list[str]) -> dict:

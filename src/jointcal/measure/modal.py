@@ -66,9 +66,13 @@ FLAG_WORDS = {
     "dead": "the response does not respond to the drive (an offset and noise: a dead or unplugged sensor; "
             "ingest's check); the run is left out",
     "shaker_on": "the force gauge goes on reading after the drive's cut (a shaker left attached): the free decay "
-                 "is the structure's and the shaker's armature's together, so it is not read as the structure's "
-                 "backbone (on a virtual 1 lbf beam with a 0.05 lbf armature it rang 2.4% low); cut the stinger or "
-                 "ring the structure down by an impact",
+                 "is the structure's and the shaker's armature's together (on a virtual 1 lbf beam with a 0.05 lbf "
+                 "armature it rang 2.4% low), and no swept run of the mode measured the modal constant that reads "
+                 "the structure's own through the force; sweep the mode too, cut the stinger or ring the structure "
+                 "down by an impact",
+    "through_force": "the force gauge goes on reading after the drive's cut (a shaker left attached): the decay "
+                     "was read through the measured force (jointcal.measure.forced_decay), the structure's own f "
+                     "and zeta, with the modal constant and residual receptance of the mode's lowest-level sweep",
     UNUSABLE: "no resonance could be estimated from this run",
 }
 

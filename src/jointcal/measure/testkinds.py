@@ -10,9 +10,16 @@ The runs of the other test kinds (`jointcal.io.test_kind`), in the order data fl
    largest ring-down window's frequency, else its spectral peak; `jointcal.measure.modes.mode_name`).
 2. **Ring-down windows** (`jointcal.measure.ringdown.ringdown_backbone`): a ring-down, and a dwell
    whose record goes on for at least `MIN_DECAY_S` after its drive is cut, give one point per window.
+   A force reference that stays live after the cut (`LIVE`: the shaker left attached) rings at the
+   coupled rig's pole: read through the force (`jointcal.measure.forced_decay`) with the modal
+   constant and residual receptance the assembly's lowest-level sweep of that mode measured
+   (``through_force``), or not read where no sweep measured them (``shaker_on``).
 3. **Dwell points** (`jointcal.measure.dwell`): each dwell's steady point; a level's dwells (three
    or more per assembly, mode and level) give the modal constant and so each dwell's natural
-   frequency and damping at the amplitude it reached, and the level's phase resonance.
+   frequency and damping at the amplitude it reached, and the level's phase resonance. Force-referenced,
+   where the mode's sweep measured its modal constant and the other modes' receptance R
+   (`jointcal.measure.receptance`), each dwell's X - R is read with that constant, however few dwells
+   a level holds: an open-loop rig's manifest level is the force each dwell measured, one per dwell.
 
 Each run keeps one row in modal_properties.csv (a ring-down's largest-amplitude window, a dwell's
 point), ``f_res_method`` naming the read-out, so the later stages read it like a sweep's.
@@ -27,6 +34,7 @@ from ..io._kinds import DWELL
 from ..spectral import peak_frequency
 from ..units import G
 from .dwell import dwell_mode, dwell_point
+from .forced_decay import forced_decay_backbone
 from .modes import mode_name
 from .ringdown import decay_start, ringdown_backbone
 
@@ -71,7 +79,7 @@ def _decay(resp: np.ndarray, ref: np.ndarray, fs: float) -> int | None:
     return start if (resp.size - start) / fs >= MIN_DECAY_S else None
 
 
-def read_test_run(row: dict, record: pd.DataFrame, kind: str, mode_hz=None) -> dict:
+def read_test_run(row: dict, record: pd.DataFrame, kind: str, mode_hz=None, receptance: dict | None = None) -> dict:
     """One dwell or ring-down run read as the modal stage reads it (steps 1-3 of the module docstring).
 
     Parameters
@@ -84,6 +92,11 @@ def read_test_run(row: dict, record: pd.DataFrame, kind: str, mode_hz=None) -> d
         The excitation.
     mode_hz : float or list of float, optional
         The frequencies to read at (``modal.mode_hz``, or the modal stage's own read: its ``mode_peak_hz``).
+    receptance : dict of float to Receptance, optional
+        Force-referenced: each swept mode's frequency (Hz) and what the campaign's sweeps measured of it
+        (`jointcal.measure.forced_decay.Receptance`). A decay that the shaker still pushes on (``shaker_on``)
+        is read through the force with the mode's within `NEAR` (flag ``through_force``); without one it
+        is not read.
 
     Returns
     -------
@@ -106,7 +119,14 @@ def read_test_run(row: dict, record: pd.DataFrame, kind: str, mode_hz=None) -> d
         f = min((float(v) for v in np.atleast_1d(mode_hz)), key=lambda v: abs(v - f))
     out = {"row": row, "f_guess": f, "start": start, "windows": None, "point": None, "notes": [], "flags": []}
     if start is not None and kind == "force" and _live_after_cut(ref, start, fs) > LIVE:
-        out["flags"].append("shaker_on")  # the decay is the structure's and the shaker's together: not read
+        near = [(abs(fm / f - 1), fm) for fm in (receptance or {}) if abs(fm / f - 1) < NEAR]
+        if near:  # the decay is the structure's and the shaker's together: read the structure's through the force
+            rc = receptance[min(near)[1]]
+            out["windows"] = forced_decay_backbone(resp, ref, fs, f, rc.modal_constant, residual=rc.residual(f),
+                                                   start=start)
+            out["flags"].append("through_force")
+        else:
+            out["flags"].append("shaker_on")  # no modal constant measured: not read
     elif start is not None:
         out["windows"] = ringdown_backbone(resp, fs, f, start=start)
     if row.get("test") == "dwell":
@@ -135,7 +155,7 @@ def _names(reads: list[dict], swept: dict[str, float], level: str) -> None:
 
 
 def other_kinds_modal(rows: list[dict], records: dict, kind: str, swept: dict[str, float],
-                      mode_hz=None) -> tuple[list[dict], list[dict]]:
+                      mode_hz=None, *, receptance: dict | None = None) -> tuple[list[dict], list[dict]]:
     """The modal rows and backbone points of one assembly's dwell and ring-down runs.
 
     Parameters
@@ -150,6 +170,9 @@ def other_kinds_modal(rows: list[dict], records: dict, kind: str, swept: dict[st
         The assembly's swept modes: name -> frequency (Hz) at their lowest level.
     mode_hz : float or list of float, optional
         The config's ``modal.mode_hz``.
+    receptance : dict of float to Receptance, optional
+        Force-referenced: per swept mode's frequency (Hz), its modal constant and residual receptance from the
+        campaign's sweeps (`read_test_run`).
 
     Returns
     -------
@@ -159,24 +182,32 @@ def other_kinds_modal(rows: list[dict], records: dict, kind: str, swept: dict[st
         `BACKBONE_COLUMNS` rows: each ring-down window (``test`` ``ringdown``) and each dwell's point.
     """
     level = LEVEL[kind]
-    reads = [read_test_run(r, records[r["run_id"]], kind, mode_hz) for r in rows if records.get(r["run_id"]) is not None]
+    reads = [read_test_run(r, records[r["run_id"]], kind, mode_hz, receptance) for r in rows
+             if records.get(r["run_id"]) is not None]
     _names(reads, swept, level)
     dwells: dict[tuple, list[dict]] = {}
     for r in reads:
         if r["point"] is not None:
             dwells.setdefault((r["mode"], float(r["row"][level])), []).append(r)
-    for group in dwells.values():
+    for (mode, _), group in dwells.items():
         pts = [r["point"] for r in group]
-        if len(pts) < 3:  # no modal constant: the points' frequencies and damping cannot be read
+        rc = (receptance or {}).get(swept.get(mode)) if kind == "force" else None
+        if len(pts) < 3 and rc is None:  # no modal constant: the points' frequencies and damping cannot be read
             nan = float("nan")
             for r in group:
                 r["dwell"] = {"q_in": r["point"]["q_in"], "f_hz": nan, "zeta": nan,
                               "fit": {"f_hz": nan, "zeta": nan, "q_in": nan, "residual": nan, "flags": ["few_dwells"]}}
             continue
-        fit = dwell_mode(np.array([p["f_hz"] for p in pts]), np.array([p["X"] for p in pts]),
-                         np.array([p["q_in"] for p in pts]), A=-G if kind == "base" else None)
-        for r, (q, f, z) in zip(group, fit["points"]):
-            r["dwell"] = {"q_in": q, "f_hz": f, "zeta": z, "fit": fit}
+        f = np.array([p["f_hz"] for p in pts])
+        X, q, A = np.array([p["X"] for p in pts]), np.array([p["q_in"] for p in pts]), -G if kind == "base" else None
+        if rc is not None:  # the mode's modal constant and the other modes' receptance, measured by its sweep
+            X = X - np.array([rc.residual(v) for v in f])
+            q, A = np.abs(X) * np.array([p["ref_amp"] for p in pts]), rc.modal_constant
+        fit = dwell_mode(f, X, q, A=A)
+        if rc is not None and len(pts) == 1:  # A measured: nothing fitted, the one point is its own read-out
+            fit["flags"] = []
+        for r, (qi, fi, zi) in zip(group, fit["points"]):
+            r["dwell"] = {"q_in": qi, "f_hz": fi, "zeta": zi, "fit": fit}
     modal, points = [], []
     for r in reads:
         row, rid = r["row"], r["row"]["run_id"]
@@ -199,7 +230,7 @@ def other_kinds_modal(rows: list[dict], records: dict, kind: str, swept: dict[st
                        dwell_residual=fit["residual"], dwell_constant_re=fit["A"].real,
                        dwell_constant_im=fit["A"].imag)
         elif w is not None and len(w):  # a ring-down, or a dwell read only along its ring-down
-            flags += r["dwell"]["fit"]["flags"] if r.get("dwell") else []
+            flags += r["flags"] + (r["dwell"]["fit"]["flags"] if r.get("dwell") else [])
             top = w.loc[w["q_in"].idxmax()]
             out.update(f_res_hz=top["f_hz"], zeta_res=top["zeta"], q_in=top["q_in"], f_res_method="ringdown")
         else:
