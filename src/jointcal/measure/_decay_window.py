@@ -9,6 +9,11 @@ the virtual Ministack: +-1% in zeta from window to window at 3 periods, -1.5% at
 the weighted centroid); the drift terms r and s take that up, and cost sigma's standard error little,
 since t^2 is nearly orthogonal to t over a window. Variable projection: a and b by linear least
 squares, (w, sigma, r, s) by Gauss-Newton with step halving, started from the constant model's fit.
+
+The drifts are still one order short where a window spans e-folds of a decay whose rate and frequency
+follow its amplitude: the log-envelope's t^3 term projects onto its slope (t^3 is odd, as t is). A caller
+that knows the third-order terms (from the neighbouring windows: `jointcal.measure.ringdown._cubic_terms`)
+holds them fixed (`cubic`), which costs no parameter; the t^4 terms left are even and do not bias the slope.
 """
 from __future__ import annotations
 
@@ -18,23 +23,25 @@ from numpy.typing import NDArray
 __all__ = ["fit_window"]
 
 
-def _basis(p: NDArray, t: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+def _basis(p: NDArray, t: NDArray, cubic: tuple[float, float] = (0.0, 0.0)) -> tuple[NDArray, NDArray, NDArray]:
     w, sig, r, s = p
-    env = np.exp(-sig * t - 0.5 * s * t * t)
-    ph = w * t + 0.5 * r * t * t
+    t3 = t * t * t
+    env = np.exp(-sig * t - 0.5 * s * t * t + cubic[1] * t3)
+    ph = w * t + 0.5 * r * t * t + cubic[0] * t3
     return env, ph, np.column_stack([env * np.cos(ph), env * np.sin(ph)])
 
 
-def _project(p: NDArray, t: NDArray, x: NDArray):
+def _project(p: NDArray, t: NDArray, x: NDArray, cubic: tuple[float, float] = (0.0, 0.0)):
     """a, b, the model, d(model)/d(phase) and the basis at the nonlinear parameters p."""
-    env, ph, B = _basis(p, t)
+    env, ph, B = _basis(p, t, cubic)
     (a, b), *_ = np.linalg.lstsq(B, x, rcond=None)
     return a, b, B @ [a, b], env * (-a * np.sin(ph) + b * np.cos(ph)), B
 
 
-def _gauss_newton(p: NDArray, t: NDArray, x: NDArray, free: int, iters: int = 40):
+def _gauss_newton(p: NDArray, t: NDArray, x: NDArray, free: int, iters: int = 40,
+                  cubic: tuple[float, float] = (0.0, 0.0)):
     """Minimise |x - model|^2 over the first `free` of (w, sigma, r, s), step halving on an increase."""
-    a, b, m, dm, B = _project(p, t, x)
+    a, b, m, dm, B = _project(p, t, x, cubic)
     cost = float(np.sum((x - m) ** 2))
     for _ in range(iters):
         J = np.column_stack([t * dm, -t * m, 0.5 * t * t * dm, -0.5 * t * t * m])[:, :free]
@@ -44,7 +51,7 @@ def _gauss_newton(p: NDArray, t: NDArray, x: NDArray, free: int, iters: int = 40
         step = np.concatenate([step / scale, np.zeros(4 - free)])
         lam = 1.0
         while lam > 1e-4:
-            trial = _project(p + lam * step, t, x)
+            trial = _project(p + lam * step, t, x, cubic)
             new = float(np.sum((x - trial[2]) ** 2))
             if new <= cost:
                 break
@@ -58,8 +65,8 @@ def _gauss_newton(p: NDArray, t: NDArray, x: NDArray, free: int, iters: int = 40
     return p, a, b, m, dm, B
 
 
-def fit_window(t: NDArray, x: NDArray, w0: float,
-               sigma0: float = 0.0) -> tuple[float, float, complex, float, float, float]:
+def fit_window(t: NDArray, x: NDArray, w0: float, sigma0: float = 0.0, *,
+               cubic: tuple[float, float] = (0.0, 0.0)) -> tuple[float, float, complex, float, float, float]:
     """Fit one window of a decay.
 
     Parameters
@@ -72,6 +79,9 @@ def fit_window(t: NDArray, x: NDArray, w0: float,
         Starting frequency, rad/s.
     sigma0 : float
         Starting decay rate, 1/s.
+    cubic : (float, float)
+        Known third-order terms of the phase and of the log-envelope, (rad/s^3, 1/s^3): the model's
+        phase gains cubic[0] t^3 and its log-envelope cubic[1] t^3, held fixed (not fitted).
 
     Returns
     -------
@@ -89,8 +99,8 @@ def fit_window(t: NDArray, x: NDArray, w0: float,
     se_w : float
         The same for w, rad/s per unit white-noise rms.
     """
-    p, *_ = _gauss_newton(np.array([w0, sigma0, 0.0, 0.0]), t, x, free=2)
-    p, a, b, m, dm, B = _gauss_newton(p, t, x, free=4)
+    p, *_ = _gauss_newton(np.array([w0, sigma0, 0.0, 0.0]), t, x, free=2, cubic=cubic)
+    p, a, b, m, dm, B = _gauss_newton(p, t, x, free=4, cubic=cubic)
     J = np.column_stack([t * dm, -t * m, 0.5 * t * t * dm, -0.5 * t * t * m, B])
     try:
         cov = np.linalg.inv(J.T @ J)
