@@ -25,6 +25,7 @@ from ..models import SweepDrive
 from ..measure.envelopes import ZETA_MIN, window_length
 from ..measure.peaks import full_drive, transmissibility
 from ..io import level_column
+from ..io.contract import UNUSABLE
 from ..validate.drive import equivalent_base
 from ..validate.error import BINS
 from ..validate.runs import full_drive_fraction
@@ -127,7 +128,7 @@ def run_envelope(env: pd.DataFrame, row: Mapping, sigma_db: NDArray, sigma_deg: 
     """
     f_res = float(row.get("f_res_hz", np.nan))
     zeta = run_zeta(row)
-    if not (np.isfinite(f_res) and np.isfinite(zeta) and zeta > 0) or "unusable" in str(row.get("flags", "")):
+    if not (np.isfinite(f_res) and np.isfinite(zeta) and zeta > 0) or UNUSABLE in str(row.get("flags", "")):
         return None
     f = env["f_drive_hz"].to_numpy(float)
     ref = (env["ref_re"] + 1j * env["ref_im"]).to_numpy()

@@ -37,6 +37,7 @@ from numpy.typing import NDArray
 
 from ..calibrate._readouts import QUAD
 from ..io import level_column
+from ..io.contract import UNUSABLE
 from ..models.free_decay import free_backbone
 from ..validate.decay import scales
 from .fit import Candidate, Fit, _least_squares, model_at
@@ -101,7 +102,7 @@ def _points(backbone: pd.DataFrame, modal: pd.DataFrame, rows: Sequence[Mapping]
     for row in rows:
         rid = str(row["run_id"])
         r = {**(mrows.loc[rid].to_dict() if rid in mrows.index else {}), **dict(row), "run_id": rid}
-        if "unusable" in str(r.get("flags", "")):
+        if UNUSABLE in str(r.get("flags", "")):
             continue
         w = bb[bb["run_id"].astype(str) == rid][["q_in", "f_hz", "zeta"]].apply(pd.to_numeric, errors="coerce")
         w = w[(w > 0).all(axis=1)]
