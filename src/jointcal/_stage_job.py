@@ -18,9 +18,16 @@ warnings, in the log and on stderr, and a non-zero exit without a traceback. `Jo
 warnings go to stderr, and the command turns the errors into its exit status (`jointcal.cli`).
 Imports nothing of the package, so a stage's code hash (`jointcal._workflow.stage_hash`) gains
 only this file.
+
+One BLAS thread per process: a job's threads are its processes (`Job.pool`), but Snakemake sets
+the BLAS and OpenMP thread variables to the rule's threads, so each worker of a pool of two would
+run two BLAS threads (four on two cores; a least-squares SVD of the discrepancy fits took 5x the
+CPU with two). Importing this module sets them to 1; it must come before numpy's first import, as
+the stage scripts and `jointcal.cli` import it first.
 """
 from __future__ import annotations
 
+import os
 import sys
 import time
 import warnings
@@ -32,6 +39,11 @@ from types import SimpleNamespace
 from typing import IO, Any
 
 __all__ = ["Job", "console_job", "stage_job"]
+
+BLAS_THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "VECLIB_MAXIMUM_THREADS",
+                         "NUMEXPR_NUM_THREADS")
+for _var in BLAS_THREAD_VARIABLES:
+    os.environ[_var] = "1"
 
 
 class Job:
