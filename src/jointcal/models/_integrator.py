@@ -143,11 +143,11 @@ def run(u, ud, maps, outputs, joints, sliders, elements, y_out, z_out):
     z_j = lz[j].x, z_j' = lv[j].x (lz, lv (J, n)); the first joint's z'' = az.x + bzu u + bzf.r
     (az (n,), bzf (J,)).
     outputs: (cy (n_y, n), dyu (n_y,), dyf (n_y, J)): y = cy.x + dyu u + dyf.r.
-    joints: (kind, KT, R, chi, phimax, Fs, zero): the first six (J,) arrays, kind 0 none, 1 exact
-    Iwan (R and chi passed as R/(chi+1), chi+1), 2 Jenkins sliders (a test reference; KT = sum of
-    their stiffnesses; at most one joint); zero a tuple of J zeros, the shape of the per-joint state
-    (a tuple, so the number of joints is known when the kernel compiles and that state stays in
-    registers: one joint runs as fast as a kernel written for one).
+    joints: (kind, KT, R, chi, phimax, Fs), each a tuple of J values: kind 0 none, 1 exact Iwan (R and
+    chi passed as R/(chi+1), chi+1), 2 Jenkins sliders (a test reference; KT = sum of their stiffnesses;
+    at most one joint). Tuples, as the per-joint state below: the number of joints is known when the
+    kernel compiles and the joints' parameters and state stay in registers (one joint: within about 5%
+    of the CPU time of the former one-joint kernel, measured on a loaded machine).
     sliders: (sk, sphi), the sliders' stiffnesses and slip displacements.
     elements: (codes (n_e,), coefs (n_e, 2)), the element table sorted by code, acting on the
     first joint's DOF z_0. Code 4 (a backbone share s, exact Iwan joint only) replaces the share
@@ -156,10 +156,10 @@ def run(u, ud, maps, outputs, joints, sliders, elements, y_out, z_out):
     """
     H, Gsub, Wub, Phi, Gf, lz, lv, az, bzu, bzf = maps
     cy, dyu, dyf = outputs
-    jkind, KT, R, chi, phimax, Fs, zero = joints
+    jkind, KT, R, chi, phimax, Fs = joints
     sk, sphi = sliders
     codes, coefs = elements
-    J = len(zero)
+    J = len(KT)
     n_el = codes.shape[0]
     n_y = cy.shape[0]
     n_sub = Gsub.shape[0]
@@ -170,13 +170,18 @@ def run(u, ud, maps, outputs, joints, sliders, elements, y_out, z_out):
     x1 = np.zeros(n)
     su = np.zeros((J, 256))  # each joint's turning points
     sF = np.zeros((J, 256))
-    ns = np.zeros(J, dtype=np.int64)
     top = 0  # the deepest stack yet
-    d = np.zeros(J, dtype=np.int64)
     sx = np.zeros(sk.shape[0])  # slider anchors
     # per joint: remainder and rate at the step's start (r0, rd0), the step before (rp), its end (r1, rd1);
     # displacement and rate at the start (z0, v0) and end (z1, v1), predicted (zp); force and tangent shift
+    zero = KT
+    for jt in range(J):
+        zero = _put(zero, jt, 0.0)
     r0 = rd0 = rp = r1 = rd1 = z0 = v0 = z1 = v1 = zp = Fj = Kd = zero
+    izero = jkind
+    for jt in range(J):
+        izero = _put(izero, jt, 0)
+    ns = d = izero  # each joint's stack depth and direction of motion
     Fiw = 0.0  # the first joint's Iwan force and tangent, for a backbone share
     Kiw = 0.0
     have_prev = False
@@ -235,8 +240,8 @@ def run(u, ud, maps, outputs, joints, sliders, elements, y_out, z_out):
                 if jkind[jt] == 1:
                     F, K, nn, dd = advance(su[jt], sF[jt], ns[jt], dj, zz, zt, turn, KT[jt], R[jt], chi[jt],
                                            phimax[jt], Fs[jt])
-                    ns[jt] = nn
-                    d[jt] = dd
+                    ns = _put(ns, jt, nn)
+                    d = _put(d, jt, dd)
                     top = max(top, nn)
                     if jt == 0:
                         Fiw = F
@@ -256,9 +261,9 @@ def run(u, ud, maps, outputs, joints, sliders, elements, y_out, z_out):
                         sx[i] = xi
                         F += sk[i] * (zz - xi)
                     if turn:
-                        d[jt] = -dj
+                        d = _put(d, jt, -dj)
                     elif dj == 0 and zz != 0.0:
-                        d[jt] = 1 if zz > 0.0 else -1
+                        d = _put(d, jt, 1 if zz > 0.0 else -1)
                 Fj = _put(Fj, jt, F - KT[jt] * zz if jkind[jt] != 0 else 0.0)
                 Kd = _put(Kd, jt, K - KT[jt] if jkind[jt] != 0 else 0.0)
             for sweep in range(2):

@@ -232,8 +232,7 @@ def _run_kernel(A: NDArray, bu: NDArray, BF: NDArray, LZ: NDArray, LV: NDArray, 
     outs = (np.ascontiguousarray(np.array([np.asarray(c, float) for c, _, _ in outputs])),
             np.array([float(d) for _, d, _ in outputs]),
             np.ascontiguousarray(np.array([np.broadcast_to(np.asarray(d, float), (J,)) for _, _, d in outputs])))
-    kinds = (np.array([c[0] for c in joints], dtype=np.int64),
-             *(np.array([c[i] for c in joints], dtype=float) for i in range(1, 6)), (0.0,) * J)
+    kinds = (tuple(int(c[0]) for c in joints), *(tuple(float(c[i]) for c in joints) for i in range(1, 6)))
     sl = (np.zeros(0), np.zeros(0)) if sliders is None else \
         tuple(np.ascontiguousarray(a, dtype=float) for a in sliders)
     Y = np.empty((len(outputs), u.size))
