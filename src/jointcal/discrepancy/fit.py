@@ -115,12 +115,16 @@ def _drive(run: RunEnvelope) -> tuple:
     return run.f_hz, run.base_g, rate, dlog, "up" if run.rate >= 0 else "down"
 
 
-def _first_order_runs(c: Candidate, theta: NDArray, runs: Sequence[RunEnvelope]) -> list[NDArray[np.complex128]]:
+def _first_order_runs(c: Candidate, theta: NDArray, runs: Sequence[RunEnvelope],
+                      model: MinistackModel | None = None) -> list[NDArray[np.complex128]]:
     """The first-order quasi-steady envelope at each run's frames, (P, n) or (n,) per run: one model for
-    all runs, unless the candidate changes with the run's place in the sequence."""
+    all runs, unless the candidate changes with the run's place in the sequence. model: the model of the
+    first run (`model_at(c, theta, runs[0].row)`) when the caller has built it."""
+    first = model_at(c, theta, runs[0].row) if model is None else model
     if c.sequence_dependent:
-        return [quasi_steady_runs(model_at(c, theta, run.row), [_drive(run)])[0] for run in runs]
-    return quasi_steady_runs(model_at(c, theta, runs[0].row), [_drive(run) for run in runs])
+        return [quasi_steady_runs(first if i == 0 else model_at(c, theta, run.row), [_drive(run)])[0]
+                for i, run in enumerate(runs)]
+    return quasi_steady_runs(first, [_drive(run) for run in runs])
 
 
 def observed(model: MinistackModel, T: NDArray, run: RunEnvelope) -> NDArray[np.complex128]:
@@ -146,7 +150,7 @@ def transient_factor(c: Candidate, theta: NDArray, run: RunEnvelope) -> NDArray[
     model = model_at(c, theta, run.row)
     swept = swept_transmissibility(model, run.drive, run.t_s, f_res_hz=float(run.row["f_res_hz"]), zeta=run_zeta(run.row))
     with np.errstate(all="ignore"):
-        factor = swept / _first_order_runs(c, theta, [run])[0]
+        factor = swept / _first_order_runs(c, theta, [run], model)[0]
     return np.where(np.isfinite(factor), factor, 1.0)
 
 
@@ -214,15 +218,16 @@ class Objective:
         """Run i's measured quantity as the model gives it at its frames as the sweep shows it, (P, n) or (n,):
         the first-order envelope times the run's transient factor, `observed`."""
         c, run, k = self.candidate, self.runs[i], self.transient[i]
-        T = _first_order_runs(c, theta, [run])[0]
-        return observed(model_at(c, theta, run.row), T if k is None else T * k, run)
+        model = model_at(c, theta, run.row)
+        T = _first_order_runs(c, theta, [run], model)[0]
+        return observed(model, T if k is None else T * k, run)
 
     def residuals(self, theta: NDArray) -> NDArray:
         """Residual vector whose sum of squares is E^2 (theta (n,) -> (m,), (P, n) -> (P, m))."""
         c, runs = self.candidate, self.runs
         with np.errstate(all="ignore"):
-            T = _first_order_runs(c, theta, runs)
             model = model_at(c, theta, runs[0].row)  # its sensor (no effect changes it along the sequence)
+            T = _first_order_runs(c, theta, runs, model)
             r = np.concatenate([_run_residual(model, t if k is None else t * k, run, len(runs))
                                 for t, k, run in zip(T, self.transient, runs)], axis=-1)
         return np.where(np.isfinite(r), r, 1e3)

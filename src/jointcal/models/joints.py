@@ -2,7 +2,7 @@
 
 `jointcal.models.simulate.integrate` holds one joint; two jointed modes coupled through a
 shaker's coil and armature (`jointcal.synth.shaker`) cannot be integrated apart, so
-`integrate_joints` runs the same scheme (`jointcal.models._joints_kernel`: exact propagation
+`integrate_joints` runs the same kernel (`jointcal.models._integrator.run`: exact propagation
 of the stuck-joint system, cubic Hermite input and remainders, predict-evaluate-correct,
 reversals located inside the step) with one remainder and one turning-point state per joint.
 Kept out of `simulate` (and of the package's namespace) so the workflow's stages, which import
@@ -15,9 +15,8 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from . import _integrator, _joints_kernel
 from .iwan import IwanParams
-from .simulate import _joint, _substep_maps, hermite_propagator
+from .simulate import _joint, _run_kernel
 
 __all__ = ["integrate_joints"]
 
@@ -27,7 +26,7 @@ def integrate_joints(A: NDArray, bu: NDArray, BF: NDArray, LZ: NDArray, LV: NDAr
                      outputs: Sequence[tuple[NDArray, float, NDArray]]) -> tuple[NDArray, NDArray]:
     """Integrate x' = A x + bu u + BF r from rest, r_j the remainder of an exact Iwan joint on z_j = LZ[j].x.
 
-    The scheme of `integrate` (`jointcal.models._joints_kernel`), each joint with its own
+    The scheme and the kernel of `integrate` (`jointcal.models._integrator.run`), each joint with its own
     turning-point state: r_j = F_iwan,j(z_j) - KT_j z_j, A holding every joint stuck. With one
     joint, or with all joints but one None, the result is `integrate`'s bit for bit.
 
@@ -59,24 +58,9 @@ def integrate_joints(A: NDArray, bu: NDArray, BF: NDArray, LZ: NDArray, LV: NDAr
     Z : ndarray, shape (J, N)
         The joint displacements at the samples, in.
     """
-    u = np.ascontiguousarray(u, dtype=float)
     BF, LZ, LV = (np.atleast_2d(np.asarray(a, dtype=float)) for a in (BF, LZ, LV))
     J = len(joints)
     if BF.shape != (A.shape[0], J) or LZ.shape != (J, A.shape[0]) or LV.shape != LZ.shape:
         raise ValueError(f"integrate_joints: BF {BF.shape}, LZ {LZ.shape}, LV {LV.shape} do not fit "
                          f"{A.shape[0]} states and {J} joints.")
-    h = 1.0 / fs / n_sub
-    Phi, Gu = hermite_propagator(A, bu, h)
-    Gf = np.ascontiguousarray(np.stack([hermite_propagator(A, BF[:, j], h)[1] for j in range(J)]))
-    Gsub, Wub = _substep_maps(Gu, n_sub)
-    maps = (1.0 / fs, Gsub, Wub, np.ascontiguousarray(Phi), Gf, np.ascontiguousarray(LZ), np.ascontiguousarray(LV))
-    outs = (np.ascontiguousarray(np.array([np.asarray(c, float) for c, _, _ in outputs])),
-            np.array([float(d) for _, d, _ in outputs]),
-            np.ascontiguousarray(np.array([np.broadcast_to(np.asarray(d, float), (J,)) for _, _, d in outputs])))
-    cols = [_joint(p, None)[0] for p in joints]
-    kinds = (np.array([c[0] for c in cols], dtype=np.int64),
-             *(np.array([c[i] for c in cols], dtype=float) for i in range(1, 6)))
-    Y = np.empty((len(outputs), u.size))
-    Z = np.empty((J, u.size))
-    _joints_kernel.run_joints(u, _integrator.rate(u, fs), maps, outs, kinds, Y, Z)
-    return Y, Z
+    return _run_kernel(A, bu, BF, LZ, LV, u, fs, n_sub, [_joint(p) for p in joints], outputs)

@@ -15,7 +15,6 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.linalg import expm
-from scipy.signal import resample_poly
 
 from collections.abc import Sequence
 
@@ -118,6 +117,9 @@ def band_limited(u: NDArray, fs: float, f_hz: float, samples_per_cycle: float = 
     values and finite-difference rates misses it by percents (measured: the exact model
     driven by a 10 kHz record read 0.2 dB low and 0.07% stiff at 2.4 kHz).
     """
+    from scipy.signal import resample_poly  # here: scipy.signal (and the scipy.stats it loads) costs a stage
+    # that never simulates 0.8 s of CPU at its start
+
     U = max(1, int(np.ceil(samples_per_cycle * f_hz / fs)))
     return (resample_poly(u, U, 1) if U > 1 else u), U
 
@@ -197,17 +199,46 @@ def neighbour_response(nb: Neighbour, u: NDArray, fs: float) -> NDArray[np.float
     return np.fft.irfft(np.fft.rfft(u, n) * nb.frf(np.fft.rfftfreq(n, 1.0 / fs)), n)[:u.size]
 
 
-def _joint(iwan: IwanParams | None, sliders: tuple[NDArray, NDArray] | None):
-    """The kernel's joint and slider arguments: (kind, KT, R, chi, phimax, Fs), (sk, sphi)."""
-    none = (np.zeros(0), np.zeros(0))
+def _joint(iwan: IwanParams | None, sliders: tuple[NDArray, NDArray] | None = None) -> tuple:
+    """One joint's kernel columns (kind, KT, R, chi, phimax, Fs)."""
     if sliders is not None:
-        sk, sphi = (np.ascontiguousarray(a, dtype=float) for a in sliders)
-        return (2, float(sk.sum()), 0.0, 0.5, 1.0, 0.0), (sk, sphi)
+        return 2, float(np.sum(sliders[0])), 0.0, 0.5, 1.0, 0.0
     if iwan is None:
-        return (0, 0.0, 0.0, 0.5, 1.0, 0.0), none
+        return 0, 0.0, 0.0, 0.5, 1.0, 0.0
     phimax, R, _ = (float(a) for a in derived(iwan.Fs, iwan.KT, iwan.chi, iwan.beta))
     R, chi = kernel_constants(R, iwan.chi)
-    return (1, float(iwan.KT), float(R), float(chi), phimax, float(iwan.Fs)), none
+    return 1, float(iwan.KT), float(R), float(chi), phimax, float(iwan.Fs)
+
+
+def _run_kernel(A: NDArray, bu: NDArray, BF: NDArray, LZ: NDArray, LV: NDArray, u: NDArray, fs: float, n_sub: int,
+                joints: Sequence[tuple], outputs: Sequence[tuple[NDArray, float, ArrayLike]], *,
+                sliders: tuple[NDArray, NDArray] | None = None, elements: Sequence[Element] = ()
+                ) -> tuple[NDArray, NDArray]:
+    """The kernel's arguments from the system's matrices, and its run (private to `integrate`, `integrate_joints`).
+
+    BF (n, J), LZ, LV (J, n) as `jointcal.models.joints.integrate_joints`; joints: J `_joint` columns; outputs
+    (c (n,), du, df (J,) or scalar); elements act on the first joint's DOF. Returns Y (n_outputs, N), Z (J, N).
+    """
+    u = np.ascontiguousarray(u, dtype=float)
+    J = len(joints)
+    h = 1.0 / fs / n_sub
+    Phi, Gu = hermite_propagator(A, bu, h)
+    Gf = np.ascontiguousarray(np.stack([hermite_propagator(A, BF[:, j], h)[1] for j in range(J)]))
+    Gsub, Wub = _substep_maps(Gu, n_sub)
+    lv0 = np.asarray(LV[0], dtype=float)
+    maps = (1.0 / fs, Gsub, Wub, np.ascontiguousarray(Phi), Gf, np.ascontiguousarray(LZ, dtype=float),
+            np.ascontiguousarray(LV, dtype=float), np.ascontiguousarray(lv0 @ A, dtype=float), float(lv0 @ bu),
+            np.array([float(lv0 @ BF[:, j]) for j in range(J)]))
+    outs = (np.ascontiguousarray(np.array([np.asarray(c, float) for c, _, _ in outputs])),
+            np.array([float(d) for _, d, _ in outputs]),
+            np.ascontiguousarray(np.array([np.broadcast_to(np.asarray(d, float), (J,)) for _, _, d in outputs])))
+    kinds = (tuple(int(c[0]) for c in joints), *(tuple(float(c[i]) for c in joints) for i in range(1, 6)))
+    sl = (np.zeros(0), np.zeros(0)) if sliders is None else \
+        tuple(np.ascontiguousarray(a, dtype=float) for a in sliders)
+    Y = np.empty((len(outputs), u.size))
+    Z = np.empty((J, u.size))
+    _integrator.run(u, _integrator.rate(u, fs), maps, outs, kinds, sl, element_table(elements), Y, Z)
+    return Y, Z
 
 
 def integrate(ss: StateSpace, u: NDArray, fs: float, n_sub: int, *, iwan: IwanParams | None = None,
@@ -241,20 +272,8 @@ def integrate(ss: StateSpace, u: NDArray, fs: float, n_sub: int, *, iwan: IwanPa
     z : ndarray, shape (N,)
         The joint DOF at the samples.
     """
-    u = np.ascontiguousarray(u, dtype=float)
     outputs = [(ss.cy, ss.dyu, ss.dyf)] if outputs is None else list(outputs)
-    h = 1.0 / fs / n_sub
-    Phi, Gu = hermite_propagator(ss.A, ss.bu, h)
-    _, Gf = hermite_propagator(ss.A, ss.bf, h)
-    Gsub, Wub = _substep_maps(Gu, n_sub)
-    az = ss.lv @ ss.A
-    maps = (1.0 / fs, Gsub, Wub, np.ascontiguousarray(Phi), np.ascontiguousarray(Gf),
-            np.ascontiguousarray(ss.lz, dtype=float), np.ascontiguousarray(ss.lv, dtype=float),
-            np.ascontiguousarray(az, dtype=float), float(ss.lv @ ss.bu), float(ss.lv @ ss.bf))
-    outs = (np.ascontiguousarray(np.array([np.asarray(c, float) for c, _, _ in outputs])),
-            np.array([float(d) for _, d, _ in outputs]), np.array([float(d) for _, _, d in outputs]))
-    joint, sl = _joint(iwan, sliders)
-    Y = np.empty((len(outputs), u.size))
-    z = np.empty_like(u)
-    _integrator.run(u, _integrator.rate(u, fs), maps, outs, joint, sl, element_table(elements), Y, z)
-    return Y, z
+    Y, Z = _run_kernel(ss.A, ss.bu, np.asarray(ss.bf, dtype=float)[:, None], np.asarray(ss.lz)[None],
+                       np.asarray(ss.lv)[None], u, fs, n_sub, [_joint(iwan, sliders)], outputs, sliders=sliders,
+                       elements=elements)
+    return Y, Z[0]
