@@ -137,11 +137,13 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     gain = drive_gain(modal[modal["assembly"] == assembly]) if level_column(modal.columns) != LEVEL["base"] else None
     if gain is not None:  # a force or voltage drives the mode through the campaign's modal constant
         rows = [{**r, "drive_gain": gain} for r in rows]
+    mine = modal[modal["assembly"] == assembly]
+    peak = mine.set_index("run_id")["mode_peak_hz"] if "mode_peak_hz" in mine else pd.Series(dtype=float)
+    # each run read at the frequency the modal stage read it at, as the validation stage reads it
+    # (`jointcal.validate.stage`): E before and after from the same read-out of the same records
+    rows = [{"mode_hz": peak.get(r["run_id"]), **r} for r in rows]
     if backbone is not None and not any(test_kind(r) == "sweep" for r in rows):  # ring-downs and dwells alone
-        mine = modal[modal["assembly"] == assembly]
-        peak = mine.set_index("run_id")["mode_peak_hz"] if "mode_peak_hz" in mine else pd.Series(dtype=float)
-        return diagnose_decays(assembly, backbone, mine, best, records,
-                               [{"mode_hz": peak.get(r["run_id"]), **r} for r in rows], space=space, scales=scales,
+        return diagnose_decays(assembly, backbone, mine, best, records, rows, space=space, scales=scales,
                                settings=settings, validate_settings=validate_settings,
                                vkw=dict(envelopes_kw=envelopes_kw, modal_kw=modal_kw, executor=executor),
                                metric_before=metric_before, frames_before=frames_before, joint_starts=joint_starts,
