@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import ast
 import difflib
+import functools
 import hashlib
 import os
 from collections.abc import Mapping, MutableMapping
@@ -97,19 +98,30 @@ def stage_sources(script: str | os.PathLike[str]) -> list[Path]:
     """
     script = Path(script).resolve()
     seen: set[Path] = set()
+    files: dict[str, Path | None] = {}  # module name -> its file, looked up once per call
     todo = [script]
     while todo:
         f = todo.pop()
         if f in seen:
             continue
         seen.add(f)
-        for name in _imported(ast.parse(f.read_bytes(), filename=str(f)), _module_name(f)):
+        for name in _imports_of(str(f), f.read_bytes(), _module_name(f)):
             parts = name.split(".")
             for i in range(1, len(parts) + 1):  # importing a.b.c runs a/__init__ and a/b/__init__ first
-                dep = _module_file(".".join(parts[:i]))
+                prefix = ".".join(parts[:i])
+                if prefix not in files:
+                    files[prefix] = _module_file(prefix)
+                dep = files[prefix]
                 if dep is not None and dep not in seen:
                     todo.append(dep)
     return [script, *sorted(seen - {script})]
+
+
+@functools.lru_cache(maxsize=None)
+def _imports_of(filename: str, text: bytes, here: tuple[str, bool] | None) -> frozenset[str]:
+    """`_imported` of a file's text, parsed once per process (a workflow's parse hashes ~17 stages, which share
+    most modules; the key is the text itself, so an edited file is parsed again)."""
+    return frozenset(_imported(ast.parse(text, filename=filename), here))
 
 
 def stage_hash(script: str | os.PathLike[str]) -> str:

@@ -15,34 +15,6 @@ from tests._support.campaign import edit_manifest
 from tests.io.test_lab_formats import NAMES, WRITERS
 
 
-@pytest.mark.slow
-def test_workflow_reads_lab_exports_as_it_reads_the_csv(tmp_path, voltage_source):
-    """The voltage campaign with one run as TDMS and the other as a Test.Lab struct: the workflow's modal
-    table is the CSV campaign's (every stage reads the record with its manifest row)."""
-    import shutil
-
-    from tests._support.workflow import snakemake, workflow_copy
-
-    lab = Path(shutil.copytree(voltage_source, tmp_path / "lab"))
-    man = read_manifest(lab / "manifest.csv")
-    for row, suffix in zip(man.to_dict("records"), (".tdms", ".mat")):
-        df = read_run(lab / row["file"], row)
-        WRITERS[suffix](lab / row["file"].replace(".csv.gz", suffix), df, {"drive_V": "V", "response_accel_g": "g"})
-        (lab / row["file"]).unlink()
-    edit_manifest(lab, lambda m: m.assign(file=[f.replace(".csv.gz", s) for f, s in zip(m["file"], (".tdms", ".mat"))],
-                                          reference_channel=NAMES["drive_V"], response_channel=NAMES["response_accel_g"]))
-    tables = {}
-    for name, campaign in (("csv", voltage_source), ("lab", lab)):
-        out = tmp_path / f"results_{name}"
-        (tmp_path / f"wf_{name}").mkdir()
-        res = snakemake(workflow_copy(tmp_path / f"wf_{name}"), "--cores", "2", "modal_properties", "--config",
-                        f"raw_data={campaign}", f"results={out}")
-        assert res.returncode == 0, res.stderr[-3000:]
-        tables[name] = pd.read_csv(out / "modal" / "modal_properties.csv", keep_default_na=False)
-    assert (tables["lab"]["f_res_method"] == "sweep_fit").all()
-    pd.testing.assert_frame_equal(tables["lab"], tables["csv"])
-
-
 FIRST = {"Fs": 313.0, "KT": 1.02e6, "chi": -0.65, "beta": 0.004, "k": 6.12e5, "zeta_v": 0.0015}
 
 
@@ -96,14 +68,32 @@ BEAM = {"k": 1022.0, "zeta_v": 0.015, "weight_lbf": 1.0}  # 100 Hz, zeta 1.5%, l
 SHAKER = {"armature_weight_lbf": 0.05, "suspension_hz": 15.0, "bl_lbf_per_A": 0.5, "coil_ohm": 2.0, "coil_mH": 0.3}
 
 
+def _lab_copy(campaign: Path, lab: Path) -> Path:
+    """A copy of a two-run voltage campaign with its first run exported as TDMS and its second as a Test.Lab struct,
+    the manifest naming each channel as the lab does."""
+    import shutil
+
+    lab = Path(shutil.copytree(campaign, lab))
+    man = read_manifest(lab / "manifest.csv")
+    for row, suffix in zip(man.to_dict("records"), (".tdms", ".mat")):
+        df = read_run(lab / row["file"], row)
+        WRITERS[suffix](lab / row["file"].replace(".csv.gz", suffix), df, {"drive_V": "V", "response_accel_g": "g"})
+        (lab / row["file"]).unlink()
+    edit_manifest(lab, lambda m: m.assign(file=[f.replace(".csv.gz", s) for f, s in zip(m["file"], (".tdms", ".mat"))],
+                                          reference_channel=NAMES["drive_V"], response_channel=NAMES["response_accel_g"]))
+    return lab
+
+
 @pytest.mark.slow
-def test_workflow_reads_a_voltage_driven_chirp_campaign(tmp_path, workdir):
+def test_workflow_reads_a_voltage_driven_chirp_campaign_and_its_lab_exports_as_the_csv(tmp_path, workdir):
     """Workflow 'modal_properties' on a voltage-driven beam campaign (eta-20 chirps, up and down):
     ingest takes level_V / drive_V, the modal stage reads the rig's pole (swept-mode fit; pair backbone
     and FRF fit beside it), each
-    run's FRF is written."""
+    run's FRF is written. The same campaign with one run as TDMS and the other as a Test.Lab struct: the workflow's
+    modal table is the CSV campaign's (every stage reads the record with its manifest row). One test, so that the
+    CSV campaign's workflow run is made once for both checks."""
     import pandas as pd
-    from tests._support.workflow import snakemake
+    from tests._support.workflow import snakemake, workflow_copy
 
     spec = {"seed": 8, "sample_rate_hz": 1024.0, "sweep": {"f_start_hz": 70.0, "f_stop_hz": 130.0,
                                                            "rate_hz_per_s": 20.0 * (97.66 * 0.0192) ** 2,
@@ -125,3 +115,12 @@ def test_workflow_reads_a_voltage_driven_chirp_campaign(tmp_path, workdir):
         assert r["zeta_sweep"] == pytest.approx(tr["zeta_rig"], rel=0.05)
         frf = pd.read_csv(out / "modal" / "frf" / f"{r['run_id']}.csv")
         assert {"h1_re", "h2_re", "coherence", "fit_re"} <= set(frf.columns)
+    lab = _lab_copy(tmp_path / "c", tmp_path / "lab")
+    (tmp_path / "wf_lab").mkdir()
+    res = snakemake(workflow_copy(tmp_path / "wf_lab"), "--cores", "2", "modal_properties", "--config",
+                    f"raw_data={lab}", f"results={tmp_path / 'results_lab'}")
+    assert res.returncode == 0, res.stderr[-3000:]
+    tables = {name: pd.read_csv(folder / "modal" / "modal_properties.csv", keep_default_na=False)
+              for name, folder in (("csv", out), ("lab", tmp_path / "results_lab"))}
+    assert (tables["lab"]["f_res_method"] == "sweep_fit").all()
+    pd.testing.assert_frame_equal(tables["lab"], tables["csv"])
