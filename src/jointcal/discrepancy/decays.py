@@ -40,7 +40,7 @@ from ..io import level_column
 from ..io.contract import UNUSABLE
 from ..models.free_decay import free_backbone
 from ..validate.decay import scales
-from .fit import Candidate, Fit, _least_squares, model_at
+from .fit import Candidate, Fit, least_squares_fit, model_at
 
 __all__ = ["DecayRun", "DecayObjective", "decay_runs", "decay_folds", "read_scatter", "BANDS", "MIN_WINDOWS"]
 
@@ -255,4 +255,4 @@ class DecayObjective:
         space = self.candidate.grown
         given = dict(zip(space.names, map(float, theta0)))
         th0 = space.vector(given, default={p.name: p.start for p in self.candidate.effect_params})
-        return _least_squares(self, th0, given, starts, max_nfev, free_joint)
+        return least_squares_fit(self, th0, given, starts, max_nfev, free_joint)

@@ -39,7 +39,7 @@ from .data import RunEnvelope, run_zeta
 from ..effects import EFFECTS, apply_effect, effects_of
 
 __all__ = ["HELD", "Candidate", "Fit", "Objective", "candidate", "structure_scales", "model_at", "observed",
-           "transient_factor"]
+           "transient_factor", "least_squares_fit"]
 
 HELD = ("beta",)  # joint parameters the envelopes barely constrain: held at the start's value by every fit
 
@@ -257,10 +257,10 @@ class Objective:
                 again = self.at(fit.theta).fit(fit.theta, starts=1, max_nfev=max_nfev, free_joint=free_joint)
                 fit = replace(again, n_eval=again.n_eval + fit.n_eval)
             return fit
-        return _least_squares(self, th0, given, starts, max_nfev, free_joint)
+        return least_squares_fit(self, th0, given, starts, max_nfev, free_joint)
 
 
-def _least_squares(obj: Objective, th0: NDArray, given: Mapping[str, float], starts: int, max_nfev: int,
+def least_squares_fit(obj: Objective, th0: NDArray, given: Mapping[str, float], starts: int, max_nfev: int,
                    free_joint: bool) -> Fit:
     """`Objective.fit` at fixed transient factors: trust-region least squares from th0 and the effect starts,
     the Jacobian one batched call of the fast model over the perturbed parameter sets."""
