@@ -10,13 +10,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from jointcal.io import ingest_campaign, read_run
-from jointcal.measure.campaign import campaign_modal
-from jointcal.measure.envelopes import envelopes, meta_dict
-from jointcal.measure.testkinds import backbone_table
 from jointcal.synth import generate
 from jointcal.synth.rig_truth import rig_pole
 from tests._support import rigs
+from tests._support.campaign import modal_tables
 
 
 @pytest.fixture(scope="module")
@@ -38,19 +35,9 @@ def lab(tmp_path_factory):
               "assemblies": {"beam": rigs.JOINTED_BEAM},
               "rig": {"reference": "force", "shaker": rigs.SMALL_SHAKER, "second_mode": rigs.SECOND_MODE}},
              folder / "campaign", folder / "truth.json")
-    runs = ingest_campaign(folder / "campaign")
-
-    def load(row):
-        record = read_run(folder / "campaign" / row["file"], row)
-        if row["test"] != "sweep":
-            return None, {}, record
-        env, meta = envelopes(record, row)
-        return env, {**meta_dict(meta), "error": ""}, record
-
-    points: list = []
-    rows, _, _ = campaign_modal(runs, load, {}, points=points)
-    table = pd.DataFrame(rows)
-    return table, backbone_table(table, points)
+    modal = modal_tables(folder)
+    return (pd.read_csv(modal / "modal_properties.csv", dtype={"flags": str}),
+            pd.read_csv(modal / "backbone.csv", dtype={"flags": str}))
 
 
 def test_the_ring_down_reads_the_structures_backbone_through_the_force(lab):
