@@ -83,7 +83,8 @@ from scipy.optimize import least_squares
 
 from ..units import G
 from ._decay_window import fit_window
-from .ringdown import BAND, EXTEND, GROW, MISFIT_MAX, MIN_CYCLES, SPAN_MAX, TAIL, ZETA_SE_MAX, decay_start
+from .ringdown import (BAND, EXTEND, MISFIT_MAX, MIN_CYCLES, TAIL, ZETA_SE_MAX, decay_start,
+                       slide_windows)
 
 __all__ = ["structure_pole", "forced_decay_backbone", "COLUMNS", "SETTLE_LIVE", "ZETA_SE_LIVE", "OUTLIER"]
 
@@ -270,24 +271,13 @@ def forced_decay_backbone(response_g: ArrayLike, force_lbf: ArrayLike, fs: float
     tail = max(n, int(TAIL * y.size))  # the band-passed records' rms where the decay has died out: the noise
     noise_x, noise_F = (float(np.sqrt(np.mean(v[-tail:] ** 2))) for v in (y, g))
     per_sample = np.sqrt(fs / (4 * BAND * f_hz))  # one independent noise sample in fs / 2B (as ringdown's)
-    rows, w0, sig0 = [], 2 * np.pi * f_hz, 0.0
-    while lo + n <= y.size:
+
+    def read(lo, n, w0, sig0):
         row, s = _read(y, g, lo, n, fs, w0, sig0, A, complex(residual), noise_x * per_sample, noise_F * per_sample)
-        good = np.isfinite(row["zeta"]) and row["zeta"] > 0 and s.real < 0 and 0.5 * w0 < s.imag < 1.5 * w0
-        longer = int(n * GROW) + 1
-        if good and row["zeta_se"] > ZETA_SE_LIVE * row["zeta"] and -s.real * longer / fs <= SPAN_MAX \
-                and lo + longer <= y.size:
-            n = longer  # too short for the noise: the same start, a longer window
-            continue
-        if not (good and row["zeta_se"] <= ZETA_SE_LIVE * row["zeta"]):
-            if not rows:  # not yet read: the loud start (the joint's distortion in the residual) may be past
-                lo += max(1, n // 2)
-                continue
-            rows[-1]["flags"] = ";".join(filter(None, [rows[-1]["flags"], "noise_floor"]))
-            break
-        rows.append(row)
-        w0, sig0 = s.imag, -s.real
-        lo += max(1, n // 2)
+        ok = bool(np.isfinite(row["zeta"]) and row["zeta"] > 0)
+        return row, s.imag, -s.real, row["zeta_se"] / row["zeta"] if ok else np.inf, ok
+
+    rows = slide_windows(read, y.size, lo, n, 2 * np.pi * f_hz, fs, ZETA_SE_LIVE)
     return _through_shaker(pd.DataFrame(rows), A, complex(residual))
 
 

@@ -85,8 +85,8 @@ from ..spectral import DRIVE_OFF, HOLD, drive_end, plateau_end
 from ..units import G
 from ._decay_window import fit_window
 
-__all__ = ["decay_start", "ringdown_backbone", "ringdown_at", "COLUMNS", "DRIVE_OFF", "HOLD", "BAND", "ZETA_SE_MAX", "MISFIT_MAX", "SETTLE",
-           "TAIL", "MIN_CYCLES", "GROW", "SPAN_MAX", "EXTEND", "SETTLE_MIXED"]
+__all__ = ["decay_start", "ringdown_backbone", "ringdown_at", "slide_windows", "COLUMNS", "DRIVE_OFF", "HOLD", "BAND",
+           "ZETA_SE_MAX", "MISFIT_MAX", "SETTLE", "TAIL", "MIN_CYCLES", "GROW", "SPAN_MAX", "EXTEND", "SETTLE_MIXED"]
 
 BAND = 0.3  # band-pass half-width, relative to the mode's frequency
 ZETA_SE_MAX = 0.01  # a window is read while its decay rate's standard error is below this share of it
@@ -282,16 +282,53 @@ def ringdown_backbone(response_g: NDArray, fs: float, f_hz: float, *, start: int
         ``misfit`` (relative rms residual), ``flags`` (``noise_floor`` on the last row read, ``misfit``).
     """
     y, i0, n, settle, noise = _prepared(response_g, fs, f_hz, start, drive, min_cycles)
-    w0, sig0, rows = 2 * np.pi * f_hz, 0.0, []
-    lo = i0 + int(round(settle * fs / f_hz))
-    while lo + n <= y.size:
+
+    def read(lo, n, w0, sig0):
         row, w, sig, se_sig = _read_window(y, lo, n, fs, f_hz, w0, sig0, noise)
-        good = sig > 0 and 0.5 * w0 < w < 1.5 * w0
+        return row, w, sig, se_sig / sig if sig > 0 else np.inf, True
+
+    rows = slide_windows(read, y.size, i0 + int(round(settle * fs / f_hz)), n, 2 * np.pi * f_hz, fs, ZETA_SE_MAX)
+    return pd.DataFrame(_refined(y, rows, fs, f_hz, noise), columns=COLUMNS)
+
+
+def slide_windows(read, size: int, lo: int, n: int, w0: float, fs: float, se_max: float) -> list[dict]:
+    """The windows along a decay (step 3 of the module's text): from sample lo, windows of n samples at first,
+    each grown by `GROW` while its damping's relative standard error exceeds se_max (until it spans `SPAN_MAX`
+    e-folds), stepping by half their length, and stopped at the first that misses (its predecessor flagged
+    ``noise_floor``); windows missing before the first is read are stepped over (the loud start).
+
+    Parameters
+    ----------
+    read : callable
+        ``read(lo, n, w0, sig0) -> (row, w, sig, rel_se, ok)``: the window of n samples from lo, started at the
+        previous window's frequency w0 (rad/s) and decay rate sig0 (1/s); its row (a dict with ``flags``), its
+        frequency w and decay rate sig, zeta's relative standard error rel_se, and whether the read is usable.
+        `forced_decay` reads through the force with the same rule.
+    size : int
+        Samples in the record.
+    lo, n : int
+        The first window's start and length, samples.
+    w0 : float
+        The mode's approximate frequency, rad/s.
+    fs : float
+        Sample rate, Hz.
+    se_max : float
+        The largest relative standard error of a window's damping read.
+
+    Returns
+    -------
+    list of dict
+        The windows' rows, in time order.
+    """
+    rows, sig0 = [], 0.0
+    while lo + n <= size:
+        row, w, sig, rel_se, ok = read(lo, n, w0, sig0)
+        good = ok and sig > 0 and 0.5 * w0 < w < 1.5 * w0
         longer = int(n * GROW) + 1
-        if good and se_sig > ZETA_SE_MAX * sig and sig * longer / fs <= SPAN_MAX and lo + longer <= y.size:
+        if good and rel_se > se_max and sig * longer / fs <= SPAN_MAX and lo + longer <= size:
             n = longer  # too short for the noise: the same start, a longer window
             continue
-        if not (good and se_sig <= ZETA_SE_MAX * sig):
+        if not (good and rel_se <= se_max):
             if not rows:  # not yet read: the loud start (the joint's distortion in the residual) may be past
                 lo += max(1, n // 2)
                 continue
@@ -300,7 +337,7 @@ def ringdown_backbone(response_g: NDArray, fs: float, f_hz: float, *, start: int
         rows.append(row)
         w0, sig0 = w, sig
         lo += max(1, n // 2)
-    return pd.DataFrame(_refined(y, rows, fs, f_hz, noise), columns=COLUMNS)
+    return rows
 
 
 def ringdown_at(response_g: NDArray, fs: float, f_hz: float, windows: pd.DataFrame, *, start: int | None = None,
