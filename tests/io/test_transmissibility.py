@@ -6,7 +6,8 @@ said in the run's row when the record cannot tell.
 
 Each bad input is built from a clean run of the example campaign (raw_data/) or of a synthetic campaign, and
 checked through `jointcal ingest CAMPAIGN RESULTS/ingest/runs.csv --on-data-problem flag` (the workflow's policy;
-its ingest rule runs the same `ingest_campaign`)."""
+its ingest rule runs the same `ingest_campaign`), or, for the example's 24 positions of a response in m/s^2, through
+`validate_run`, which `ingest_campaign` calls for each run alone."""
 from __future__ import annotations
 
 import warnings
@@ -19,7 +20,7 @@ import pytest
 from jointcal.io import CampaignError, CampaignWarning, ingest_campaign, read_manifest, read_run, validate_run
 from jointcal.io._amplitudes import low_frequency_ratio
 from jointcal.units import G_SI  # m/s^2 per g
-from tests._support.campaign import REPO, edit_run
+from tests._support.campaign import EXAMPLE, REPO, edit_run
 from tests._support.ingest import FILE, OTHER, RUN, _flagged, _one_sentence, _scale
 
 
@@ -90,30 +91,85 @@ def fast_campaigns(tmp_path_factory) -> dict[int, Path]:
     return out
 
 
-CAMPAIGN_POSITIONS = [(2, 0), (2, 1), (3, 0), (3, 1), (3, 2)] + [
-    pytest.param(24, i, marks=() if i in (0, 1, 12, 23) else pytest.mark.slow) for i in range(24)]
+# the response-units check is per run: `ingest_campaign` validates each run's record alone (`validate_run`, whose
+# `level_problems` compares the response with its own base) and compares no run with another, so a run's position
+# in its campaign decides nothing. The whole ingest is run where a bug of the campaign's loop would show (the
+# first, second, middle and last of the example's 24 runs; every run of the 2- and 3-run campaigns); every one of
+# the example's 24 positions is checked through `validate_run` itself, the function the ingest calls for each run,
+# against the clean campaign's rows made once (`example_runs`).
+END_TO_END = [(2, 0), (2, 1), (3, 0), (3, 1), (3, 2), (24, 0), (24, 1), (24, 12), (24, 23)]
+M_S2_WORDS = ("the response read from 'response_accel_g' as g is", "is it in m/s^2?",
+              "name the column response_accel_m_s2 (it holds m/s^2) or export it in g")
 
 
-@pytest.mark.parametrize("n, position", CAMPAIGN_POSITIONS)
-def test_a_response_in_m_s2_under_the_g_name_is_flagged_in_a_campaign_of_any_size(tmp_path, fast_campaigns, capsys,
-                                                                                   n, position):
-    """One run's response exported in m/s^2 under the g name (x9.80665), at each position of a campaign of 2, 3
-    (synthetic, the issue's fast-swept damped joint, whose 10 g response peaks at the band's top) or 24 runs (the
-    example): that run alone is flagged with one sentence naming its file, the run and the fix; every other run's
-    row says its g was confirmed."""
+def _m_s2_under_the_g_name(src: Path, campaign: Path, row) -> None:
+    """Copy run `row`'s file from campaign `src` into `campaign` with its response x9.80665 (m/s^2 under the g name)."""
     import shutil
 
-    src = REPO / "raw_data" if n == 24 else fast_campaigns[n]
+    (campaign / row["file"]).parent.mkdir(parents=True, exist_ok=True)
+    shutil.copy(src / row["file"], campaign / row["file"])
+    edit_run(campaign, row["file"], _scale("response_accel_g", G_SI))
+
+
+@pytest.fixture(scope="module")
+def example_runs() -> list[tuple[pd.Series, dict]]:
+    """The example campaign's 24 runs in manifest order: each manifest row and what `ingest_campaign` (whole, warnings
+    raised) says of it, the clean campaign made once (read only)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        runs = ingest_campaign(EXAMPLE)
+    rows = [row for _, row in read_manifest(EXAMPLE / "manifest.csv").iterrows()]
+    assert len(rows) == len(runs) == 24 and list(runs["run_id"]) == [r["run_id"] for r in rows]
+    return list(zip(rows, runs.to_dict("records")))
+
+
+@pytest.mark.parametrize("n, position", END_TO_END)
+def test_a_response_in_m_s2_under_the_g_name_is_flagged_in_a_campaign_of_any_size(tmp_path, fast_campaigns, capsys,
+                                                                                   request, n, position):
+    """One run's response exported in m/s^2 under the g name (x9.80665), at the first, second, middle or last
+    position of the example's 24 runs or at each of a campaign of 2 or 3 (synthetic, the issue's fast-swept damped
+    joint, whose 10 g response peaks at the band's top), through the whole `jointcal ingest`: that run alone is
+    flagged with one sentence naming its file, the run and the fix; every other run's row says its g was confirmed
+    (on the example: word for word the row it has in the clean campaign)."""
+    import shutil
+
+    src = EXAMPLE if n == 24 else fast_campaigns[n]
     campaign = Path(shutil.copytree(src, tmp_path / "c", ignore=shutil.ignore_patterns("*.yaml", "README.md")))
     row = read_manifest(campaign / "manifest.csv").iloc[position]
     assert len(read_manifest(campaign / "manifest.csv")) == n
-    edit_run(campaign, row["file"], _scale("response_accel_g", G_SI))
+    _m_s2_under_the_g_name(src, campaign, row)
     runs = _flagged(campaign, capsys, row["run_id"], "units:response_accel_g", f"{row['file']}: below resonance",
-                    "the response read from 'response_accel_g' as g is", "is it in m/s^2?",
-                    "name the column response_accel_m_s2 (it holds m/s^2) or export it in g",
-                    f"or remove run '{row['run_id']}' from manifest.csv")
+                    *M_S2_WORDS, f"or remove run '{row['run_id']}' from manifest.csv")
     assert runs.loc[row["run_id"], "response_units_check"].startswith("flagged: response/base")
     assert runs.drop(index=row["run_id"])["response_units_check"].str.startswith("g confirmed").all()
+    if n == 24:
+        clean = {c["run_id"]: c["response_units_check"] for _, c in request.getfixturevalue("example_runs")
+                 if c["run_id"] != row["run_id"]}
+        assert runs.drop(index=row["run_id"])["response_units_check"].to_dict() == clean
+
+
+@pytest.mark.parametrize("position", range(24))
+def test_a_response_in_m_s2_under_the_g_name_is_flagged_at_each_position_of_the_example(tmp_path, example_runs,
+                                                                                        position):
+    """Each of the example's 24 runs with its response in m/s^2 under the g name, read and validated as
+    `ingest_campaign` reads and validates each run: flagged alone with one sentence naming its file, the run and the
+    fix; every other run is the clean campaign's, clean and g confirmed. The record is scaled in memory (x9.80665, as
+    above but without the gzip CSV rewrite, 0.65 s a run, whose 9 digits change nothing the check reads)."""
+    row, _ = example_runs[position]
+    path = tmp_path / "c" / row["file"]  # where the whole ingest above reads it: the message names it
+    df = read_run(EXAMPLE / row["file"], row)
+    df["response_accel_g"] = df["response_accel_g"] * G_SI
+    with pytest.warns(CampaignWarning) as record:
+        checks = validate_run(df, row, path, on_data_problem="flag")
+    warned = [str(w.message) for w in record if issubclass(w.category, CampaignWarning)]
+    assert len(warned) == 1, warned
+    _one_sentence(warned[0], f"{row['file']}: below resonance", *M_S2_WORDS,
+                  f"or remove run '{row['run_id']}' from manifest.csv")
+    assert checks["flags"] == ["units:response_accel_g"]
+    assert checks["response_units_check"].startswith("flagged: response/base")
+    others = [c for i, (_, c) in enumerate(example_runs) if i != position]
+    assert len(others) == 23 and all(c["flags"] == "" for c in others)
+    assert all(c["response_units_check"].startswith("g confirmed") for c in others)
 
 
 def test_the_issue_campaign_is_read_from_the_ratio_below_a_resonance_above_the_band(fast_campaigns):
@@ -152,8 +208,9 @@ def test_a_run_whose_record_cannot_tell_its_response_units_says_so_in_its_row(tm
     assert volt["response_units_check"].str.startswith("not checkable: a voltage-driven record").all()
 
 
-def test_units_check_has_no_false_positive_on_the_example_runs():
-    """All 24 runs: the response/base ratio at the band's bottom, over a single mode's rise, is 1 within 2%."""
+def test_units_check_has_no_false_positive_on_the_example_runs(example_runs):
+    """All 24 runs: the response/base ratio at the band's bottom, over a single mode's rise, is 1 within 2%; the whole
+    ingest (`example_runs`, warnings raised) flags none and confirms g for each."""
     man = read_manifest(REPO / "raw_data" / "manifest.csv")
     for row in man.to_dict("records"):
         df = read_run(REPO / "raw_data" / row["file"], row)
@@ -161,9 +218,8 @@ def test_units_check_has_no_false_positive_on_the_example_runs():
                                                    row["sample_rate_hz"], row["f_start_hz"], row["f_stop_hz"],
                                                    row["sweep_rate_hz_per_s"])
         assert ratio * (1 - (f_low / f_peak) ** 2) == pytest.approx(1.0, abs=0.02), row["run_id"]
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        runs = ingest_campaign(REPO / "raw_data")
+    runs = pd.DataFrame([checks for _, checks in example_runs])
+    assert len(runs) == 24
     assert (runs["flags"] == "").all() and runs["response_units_check"].str.startswith("g confirmed").all()
 
 

@@ -12,7 +12,7 @@ import pytest
 from jointcal.calibrate.data import select_modal
 from jointcal.units import G_SI  # m/s^2 per g
 from tests._support.campaign import edit_manifest, edit_run
-from tests._support.ingest import FILE, OTHER, RUN, _scale, _set, _si
+from tests._support.ingest import FILE, RUN, _scale, _set, _si
 from tests._support.workflow import snakemake
 
 
@@ -33,11 +33,13 @@ def test_workflow_keeps_the_nan_warning_when_an_error_follows(tmp_path, campaign
 
 @pytest.mark.slow
 def test_workflow_keeps_a_units_mistake_out_of_the_modal_fit(tmp_path, campaign, workdir):
-    """Flagged before calibration: a record in m/s^2 reaches modal_properties.csv as unusable
-    (select_modal leaves it out; a wrong level takes the same path, see tests/io/test_amplitudes.py). Its file
-    and a clean run's file share a basename in two folders (2 runs: CI time)."""
+    """Flagged before calibration: a record in m/s^2 and a run whose response alone is in m/s^2 under the g name
+    each reach modal_properties.csv as unusable, each flagged with its own sentence (select_modal leaves both out;
+    a wrong level takes the same path, see tests/io/test_amplitudes.py). The record in m/s^2 and a clean run's
+    file share a basename in two folders (3 runs: CI time)."""
     edit_run(campaign, "run03.csv.gz", _si)
-    edit_manifest(campaign, lambda m: m[m["run_id"].isin(["run01", "run03"])])
+    edit_run(campaign, "run02.csv.gz", _scale("response_accel_g", G_SI))
+    edit_manifest(campaign, lambda m: m[m["run_id"].isin(["run01", "run02", "run03"])])
     for rid, folder in (("run01", "a"), ("run03", "b")):
         (campaign / folder).mkdir()
         shutil.move(campaign / f"{rid}.csv.gz", campaign / folder / "run.csv.gz")
@@ -46,12 +48,16 @@ def test_workflow_keeps_a_units_mistake_out_of_the_modal_fit(tmp_path, campaign,
     out = tmp_path / "results"
     res = snakemake(workdir, "--cores", "2", str(out / "modal" / "modal_properties.csv"),
                     "--config", f"raw_data={campaign}", f"results={out}")
-    assert res.returncode == 0, res.stderr
-    assert "b/run.csv.gz: base amplitude is 19.6 g" in (out / "logs" / "ingest.log").read_text()
+    assert res.returncode == 0, res.stderr[-3000:]
+    ingest_log = (out / "logs" / "ingest.log").read_text()
+    assert "b/run.csv.gz: base amplitude is 19.6 g" in ingest_log
+    assert "run02.csv.gz: below resonance" in ingest_log
     assert "run03: unusable: ingest flagged level:base_accel_g" in (out / "logs" / "modal.log").read_text()
     modal = pd.read_csv(out / "modal" / "modal_properties.csv", keep_default_na=False).set_index("run_id")
     assert modal.loc["run03", "flags"].split(";")[:1] == ["level:base_accel_g"]
+    assert modal.loc["run02", "flags"].split(";")[0] == "units:response_accel_g"
     assert "unusable" in modal.loc["run03", "flags"] and "unusable" not in modal.loc["run01", "flags"]
+    assert "unusable" in modal.loc["run02", "flags"].split(";")
     assert select_modal(modal.reset_index(), "first").run_id == ("run01",)
 
 
@@ -74,20 +80,3 @@ def test_workflow_names_a_windows_path_or_a_missing_file_before_looking_for_inpu
     log = (out / "logs" / "ingest.log").read_text().splitlines()
     assert len(log) == 1 and words in log[0]
     assert not (out / "ingest").exists()
-
-
-@pytest.mark.slow
-def test_workflow_keeps_a_response_units_mistake_out_of_the_calibration(tmp_path, example, workdir):
-    """The flagged run reaches modal_properties.csv as unusable; the calibration's selection leaves it out."""
-    from jointcal.calibrate.data import select_modal
-
-    edit_run(example, FILE, _scale("response_accel_g", G_SI))
-    out = tmp_path / "results"
-    res = snakemake(workdir, "--cores", "2", str(out / "modal" / "modal_properties.csv"),
-                    "--config", f"raw_data={example}", f"results={out}")
-    assert res.returncode == 0, res.stderr[-3000:]
-    assert f"{FILE}: below resonance" in (out / "logs" / "ingest.log").read_text()
-    modal = pd.read_csv(out / "modal" / "modal_properties.csv", keep_default_na=False).set_index("run_id")
-    assert modal.loc[RUN, "flags"].split(";")[0] == "units:response_accel_g"
-    assert "unusable" in modal.loc[RUN, "flags"].split(";") and "unusable" not in modal.loc[OTHER, "flags"]
-    assert select_modal(modal.reset_index(), "first").run_id == (OTHER,)
