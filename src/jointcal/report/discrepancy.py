@@ -24,15 +24,24 @@ def residual_map_figure(res: pd.DataFrame, diagnosis: Mapping, path) -> None:
                 r = r.sort_values("f_over_fres")
                 axes[0].plot(r["f_over_fres"], r["z_mag"], ls, color=cmap(i), lw=1, label=f"{lev:g} g {d}")
                 axes[1].plot(r["f_over_fres"], r["z_phase"], ls, color=cmap(i), lw=1)
-    for ax, what in zip(axes, ("magnitude", "phase")):
-        ax.axhspan(-1, 1, color="0.85", zorder=0)
-        ax.set_ylabel(f"{what} residual\n(repeat-scatter units)", fontsize=10)
-        ax.tick_params(labelsize=9)
     h, lab = axes[0].get_legend_handles_labels()
     uniq = dict(zip(lab, h))
     axes[0].legend(uniq.values(), uniq.keys(), fontsize=8, ncol=4)
-    axes[1].set_xlabel("f / f_res (measured)", fontsize=10)
-    axes[0].set_title(f"{diagnosis['assembly']}: measured / baseline model; decision: {diagnosis['effect']} "
+    _residual_axes(fig, axes, ("magnitude", "phase"), "repeat-scatter units", "f / f_res (measured)",
+                   "measured / baseline model", diagnosis, path)
+
+
+def _residual_axes(fig, axes, whats: tuple[str, str], units: str, xlabel: str, what_over_what: str,
+                   diagnosis: Mapping, path) -> None:
+    """A residual map's two panels labelled (the +-1 band of the scatter shaded), titled with the decision, saved."""
+    import matplotlib.pyplot as plt
+
+    for ax, what in zip(axes, whats):
+        ax.axhspan(-1, 1, color="0.85", zorder=0)
+        ax.set_ylabel(f"{what} residual\n({units})", fontsize=10)
+        ax.tick_params(labelsize=9)
+    axes[1].set_xlabel(xlabel, fontsize=10)
+    axes[0].set_title(f"{diagnosis['assembly']}: {what_over_what}; decision: {diagnosis['effect']} "
                       f"({diagnosis['confidence']})", fontsize=11)
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -81,16 +90,9 @@ def decay_residual_figure(res: pd.DataFrame, diagnosis: Mapping, path) -> None:
         r = r.sort_values("q_in")
         axes[0].semilogx(r["q_in"], r["r_f"], "o-", ms=3, lw=1, label=str(rid))
         axes[1].semilogx(r["q_in"], r["r_zeta"], "o-", ms=3, lw=1)
-    for ax, what in zip(axes, ("frequency", "damping")):
-        ax.axhspan(-1, 1, color="0.85", zorder=0)
-        ax.set_ylabel(f"{what} residual\n(read-out scatter units)", fontsize=10)
-        ax.tick_params(labelsize=9)
     axes[0].legend(fontsize=7)
-    axes[1].set_xlabel("amplitude q (in)", fontsize=10)
-    axes[0].set_title(f"{diagnosis['assembly']}: baseline backbone / measured ring-downs; decision: "
-                      f"{diagnosis['effect']} ({diagnosis['confidence']})", fontsize=11)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _residual_axes(fig, axes, ("frequency", "damping"), "read-out scatter units", "amplitude q (in)",
+                   "baseline backbone / measured ring-downs", diagnosis, path)
 
 
 def decay_before_after_figure(frames_before: Mapping[str, pd.DataFrame], frames_after: Mapping[str, pd.DataFrame],
