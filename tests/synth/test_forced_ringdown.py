@@ -6,10 +6,17 @@ the jointed beam of tests/_support/rigs.py (exact Iwan, a 230 Hz second mode, it
 the same measured modal constant and receptance."""
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pandas as pd
 import pytest
 
+from jointcal.io import ingest_campaign, read_run
+from jointcal.measure.testkinds import RECEPTANCE_COLUMNS
+from jointcal.models import IwanParams
+from jointcal.validate.drive import drive_gain
+from jointcal.validate.testkinds import as_read, validate_test_run
 from jointcal.synth import generate
 from jointcal.synth.rig_truth import rig_pole
 from tests._support import rigs
@@ -37,11 +44,11 @@ def lab(tmp_path_factory):
              folder / "campaign", folder / "truth.json")
     modal = modal_tables(folder)
     return (pd.read_csv(modal / "modal_properties.csv", dtype={"flags": str}),
-            pd.read_csv(modal / "backbone.csv", dtype={"flags": str}))
+            pd.read_csv(modal / "backbone.csv", dtype={"flags": str}), folder / "campaign")
 
 
 def test_the_ring_down_reads_the_structures_backbone_through_the_force(lab):
-    table, bb = lab
+    table, bb, _ = lab
     row = table[table["test"] == "ringdown"].iloc[0]
     assert "through_force" in row["flags"] and "unusable" not in row["flags"]  # before: shaker_on, not read
     rd = bb[(bb["test"] == "ringdown") & (bb["run_id"] == row["run_id"])]  # (the dwells' own decays are read too)
@@ -57,7 +64,7 @@ def test_the_ring_down_reads_the_structures_backbone_through_the_force(lab):
 
 def test_its_sweep_measured_what_the_read_needs(lab):
     # the lowest-level sweep's modal constant (the swept-mode fit's) is the beam's 1/m within 1% (here -0.29%)
-    table, _ = lab
+    table, _, _ = lab
     sweep = table[table["f_res_method"] == "sweep_fit"].iloc[0]
     model, _, _ = rigs.rig()
     assert abs(sweep["modal_constant_re"] * model.m - 1) < 0.01
@@ -67,9 +74,33 @@ def test_each_open_loop_dwell_reads_its_own_point_with_the_sweeps_constant(lab):
     # an open-loop force-referenced dwell's manifest level is the force it measured: a level per dwell, too few for
     # the modal constant's fit (before: few_dwells, unusable); read with the sweep's A and R each dwell gives the
     # structure's f and zeta at its amplitude (issue 31's dwell line, 0.05% / 2%)
-    table, bb = lab
+    table, bb, _ = lab
     dw = table[table["test"] == "dwell"]
     assert len(dw) == 2 and not dw["flags"].str.contains("few_dwells|unusable").any()
     f_t, z_t = np.array([rigs.truth_curve("force", q) for q in dw["q_in"]]).T
     assert np.abs(dw["f_res_hz"] / f_t - 1).max() < 5e-4 and np.abs(dw["zeta_res"] / z_t - 1).max() < 0.02
     assert len(bb[bb["test"] == "dwell"]) == 2
+
+
+def test_validation_reads_the_ring_down_through_the_force_as_the_modal_stage_did(lab):
+    # the validation stage reads each run as the modal stage did (`validate.testkinds.as_read`): this decay through
+    # the force, with the constants its sweep measured; the model's free decay is the structure's own, as is that
+    # read, so the truth meets it within issue 31's read-out lines, and a joint that slips earlier does not
+    table, _, campaign = lab
+    runs = ingest_campaign(campaign)
+    row = as_read(runs[runs["test"] == "ringdown"].to_dict("records"), table)[0]
+    row["drive_gain"] = drive_gain(table)  # the campaign's modal constant, as the stage drives the model
+    record = read_run(campaign / row["file"], row)
+    model = rigs.rig()[0]
+    _, m = validate_test_run(model, record, row)
+    # measured (seed 5): 20 windows over 1.92 decades; f +0.008%, zeta -0.5% (means); E_f 1.46, E_zeta 1.26
+    assert m["n_windows"] >= 15 and m["decades"] >= 1.5
+    assert abs(m["f_rel_err_mean"]) < 1e-3 and abs(m["zeta_rel_err_mean"]) < 0.03
+    assert m["E_f"] < 2.0 and m["E_zeta"] < 2.0
+    iw = model.iwan
+    _, wrong = validate_test_run(replace(model, iwan=IwanParams(0.7 * iw.Fs, iw.KT, iw.chi, iw.beta)), record, row)
+    # measured: f -0.17%, zeta +3.8%, E_f 31, E_zeta 6.9
+    assert wrong["f_rel_err_mean"] < -1e-3 and wrong["zeta_rel_err_mean"] > 0.03 and wrong["E_f"] > 10
+    bare = {k: v for k, v in row.items() if k not in RECEPTANCE_COLUMNS}  # before: not read (shaker_on)
+    _, before = validate_test_run(model, record, bare)
+    assert before["n_frames"] == 0 and "no decay to read" in before["note"]

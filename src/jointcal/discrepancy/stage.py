@@ -43,6 +43,7 @@ from ..calibrate.kind import backbone_at
 from ..io import level_column, test_kind
 from ..io.contract import LEVEL
 from ..validate.drive import drive_gain
+from ..validate.testkinds import as_read
 from ..measure.envelopes import ZETA_MIN
 from ..posterior.sampler import TAU_FACTOR
 from ..validate import ValidateSettings, model_from_best, validate_runs
@@ -138,10 +139,9 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     if gain is not None:  # a force or voltage drives the mode through the campaign's modal constant
         rows = [{**r, "drive_gain": gain} for r in rows]
     mine = modal[modal["assembly"] == assembly]
-    peak = mine.set_index("run_id")["mode_peak_hz"] if "mode_peak_hz" in mine else pd.Series(dtype=float)
-    # each run read at the frequency the modal stage read it at, as the validation stage reads it
-    # (`jointcal.validate.stage`): E before and after from the same read-out of the same records
-    rows = [{"mode_hz": peak.get(r["run_id"]), **r} for r in rows]
+    # each run read as the modal stage read it (its frequency; a decay through the force with its measured
+    # constants), as the validation stage reads it: E before and after from the same read-out of the same records
+    rows = as_read(rows, mine)
     if backbone is not None and not any(test_kind(r) == "sweep" for r in rows):  # ring-downs and dwells alone
         return diagnose_decays(assembly, backbone, mine, best, records, rows, space=space, scales=scales,
                                settings=settings, validate_settings=validate_settings,

@@ -95,8 +95,8 @@ SETTLE_LIVE = 3.0  # periods after the decay's start left out: the start found f
 # up to half a period before the cut (4.4 ms at 97 Hz on the virtual beam), and the force is not the shaker's
 # reaction alone for a period or two after it (at 2 periods the first window's zeta read up to 4% off)
 
-COLUMNS = ["t_s", "window_s", "q_in", "f_hz", "zeta", "zeta_se", "f_rig_hz", "zeta_rig", "force_share", "K_chi2",
-           "misfit", "flags"]
+COLUMNS = ["t_s", "window_s", "q_in", "f_hz", "zeta", "zeta_se", "f_se_hz", "f_rig_hz", "zeta_rig", "force_share",
+           "K_chi2", "misfit", "flags"]
 
 
 def structure_pole(s: ArrayLike, K: ArrayLike, modal_constant: complex,
@@ -142,7 +142,7 @@ def _basis(p: NDArray, t: NDArray) -> NDArray:
 
 
 def _pair_window(t: NDArray, x: NDArray, F: NDArray, w0: float, sig0: float,
-                 ratio: float) -> tuple[complex, complex, complex, float, float, float, complex]:
+                 ratio: float) -> tuple[complex, complex, complex, float, tuple[float, float], float, complex]:
     """One window of both channels as one decaying oscillation: a damped sinusoid, its frequency and decay rate
     drifting linearly over the window, with each channel's own amplitude and phase.
 
@@ -151,7 +151,7 @@ def _pair_window(t: NDArray, x: NDArray, F: NDArray, w0: float, sig0: float,
     the amplitudes by variable projection; started from the response's own fit (`fit_window`). Returns
     s = -sigma + i w at the window's centre (1/s), the phasors of x and F there (their units; the signal is
     Re(phasor e^{i w t}) near t = 0), the response's relative rms misfit, and per unit rms of the response's
-    white noise the standard error of sigma (1/s), and per unit of the force's that of the force's phasor
+    white noise the standard errors of w and sigma (rad/s, 1/s), and per unit of the force's that of the force's phasor
     (sqrt of the trace of (B^T B)^-1); last, s from the response alone (`fit_window`).
     """
     w, sig, *_ = fit_window(t, x, w0, sig0)
@@ -170,11 +170,12 @@ def _pair_window(t: NDArray, x: NDArray, F: NDArray, w0: float, sig0: float,
     (ax, bx), (aF, bF) = np.linalg.lstsq(B, both, rcond=None)[0].T
     res = float(np.sqrt(np.mean(misfit(sol.x)[:t.size] ** 2)) / max(np.hypot(ax, bx) / np.sqrt(2), 1e-300))
     try:
-        se_sig = float(np.sqrt(np.linalg.inv(sol.jac.T @ sol.jac)[1, 1]) * scale[1])
+        cov = np.linalg.inv(sol.jac.T @ sol.jac)
+        se_w, se_sig = float(np.sqrt(cov[0, 0]) * scale[0]), float(np.sqrt(cov[1, 1]) * scale[1])
         se = float(np.sqrt(np.trace(np.linalg.inv(B.T @ B))))
     except np.linalg.LinAlgError:
-        se_sig = se = np.inf
-    return complex(-p[1], p[0]), complex(ax, -bx), complex(aF, -bF), res, se_sig, se, complex(-sig, w)
+        se_w = se_sig = se = np.inf
+    return complex(-p[1], p[0]), complex(ax, -bx), complex(aF, -bF), res, (se_w, se_sig), se, complex(-sig, w)
 
 
 def _apart(x: NDArray, F: NDArray, i0: int, n: int, fs: float, f_hz: float) -> tuple[NDArray, NDArray]:
@@ -245,8 +246,8 @@ def forced_decay_backbone(response_g: ArrayLike, force_lbf: ArrayLike, fs: float
     DataFrame
         One row per window, in time order: ``t_s`` (its centre, s from the record's start), ``window_s``
         (its length, s), ``q_in`` (the structure's displacement amplitude at the centre, in: |X - R P|),
-        ``f_hz`` and ``zeta`` (the structure's own, `structure_pole`; Hz), ``zeta_se`` (zeta's standard
-        error from both channels' noise), ``f_rig_hz`` and ``zeta_rig`` (the decay's own pole |s| / 2 pi and
+        ``f_hz`` and ``zeta`` (the structure's own, `structure_pole`; Hz), ``zeta_se`` and ``f_se_hz`` (their
+        standard errors from both channels' noise; Hz), ``f_rig_hz`` and ``zeta_rig`` (the decay's own pole |s| / 2 pi and
         sigma / |s|: the coupled rig's, what `ringdown_backbone` reads), ``force_share`` (|A P / X| / |s|^2:
         how much of the decay the force carries; 0 for a free decay), ``misfit`` (the response's relative
         rms residual) and ``flags`` (``noise_floor`` on the last row read, ``misfit``).
@@ -303,7 +304,9 @@ def _through_shaker(t: pd.DataFrame, A: complex, R: complex) -> pd.DataFrame:
                                B.conj()).real)  # the fitted K's standard error at each window
     wn, z = structure_pole(s, fit, A, R)
     dz = np.abs(A) * se_fit / (2 * s.imag * wn)  # through Im(A K) / w
+    df = np.abs(A) * se_fit / (2 * wn) / (2 * np.pi)  # through Re(A K) in wn^2, Hz
     return t.assign(f_hz=wn / (2 * np.pi), zeta=z, zeta_se=np.hypot(t["zeta_se_rate"], dz),
+                    f_se_hz=np.hypot(t["f_se_hz"], df),
                     f_rig_hz=np.abs(s) / (2 * np.pi), zeta_rig=-s.real / np.abs(s),
                     K_chi2=float(np.sum(np.abs((K - fit) * wt) ** 2) / max(np.count_nonzero(wt), 1)))[COLUMNS]
 
@@ -316,14 +319,15 @@ def _read(y: NDArray, g: NDArray, lo: int, n: int, fs: float, w0: float, sig0: f
     rate's share alone (the stop rule's: K is then fitted over the decay, `_through_shaker`); ``K_se`` is K's
     standard error from the force's noise."""
     t = (np.arange(n) - (n - 1) / 2) / fs
-    s, px, pF, res, se_sig, se_p, s_resp = _pair_window(t, y[lo:lo + n], g[lo:lo + n], w0, sig0,
+    s, px, pF, res, (se_w, se_sig), se_p, s_resp = _pair_window(t, y[lo:lo + n], g[lo:lo + n], w0, sig0,
                                                 noise_x / noise_F if noise_F > 0 else 0.0)
     X = px * G / s**2  # displacement, in
     wn, z = (float(v[0]) for v in structure_pole(s, pF / X, A, R))
     share = abs(A * pF / X) / abs(s) ** 2
     se_rate = se_sig * noise_x / wn  # zeta's standard error from the decay rate's (c' holds 2 sigma)
     row = dict(t_s=(lo + (n - 1) / 2) / fs, window_s=n / fs, q_in=abs(X - R * pF), f_hz=wn / (2 * np.pi), zeta=z,
-               zeta_se=se_rate, zeta_se_rate=se_rate, f_rig_hz=abs(s) / (2 * np.pi), zeta_rig=-s.real / abs(s),
+               zeta_se=se_rate, zeta_se_rate=se_rate, f_se_hz=se_w * noise_x / (2 * np.pi),
+               f_rig_hz=abs(s) / (2 * np.pi), zeta_rig=-s.real / abs(s),
                force_share=share, misfit=res, flags="misfit" if res > MISFIT_MAX else "", s=s, K=pF / X,
                K_se=abs(pF / X) * se_p * noise_F / max(abs(pF), 1e-300), s_resp=s_resp)
     return row, s

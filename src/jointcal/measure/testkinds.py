@@ -36,9 +36,11 @@ from ..units import G
 from .dwell import dwell_mode, dwell_point
 from .forced_decay import forced_decay_backbone
 from .modes import mode_name
+from .receptance import Receptance
 from .ringdown import decay_start, ringdown_backbone
 
-__all__ = ["other_kinds_modal", "backbone_table", "read_test_run", "BACKBONE_COLUMNS", "MIN_DECAY_S", "NEAR"]
+__all__ = ["other_kinds_modal", "backbone_table", "read_test_run", "receptance_row", "row_receptance",
+           "BACKBONE_COLUMNS", "RECEPTANCE_COLUMNS", "MIN_DECAY_S", "NEAR"]
 
 BACKBONE_COLUMNS = ["run_id", "mode", "test", "q_in", "f_hz", "zeta"]
 MIN_DECAY_S = 1.0  # a dwell's record this long after the cut holds a ring-down to read (as decay_start asks)
@@ -125,6 +127,7 @@ def read_test_run(row: dict, record: pd.DataFrame, kind: str, mode_hz=None, rece
             out["windows"] = forced_decay_backbone(resp, ref, fs, f, rc.modal_constant, residual=rc.residual(f),
                                                    start=start)
             out["flags"].append("through_force")
+            out["receptance"] = rc
         else:
             out["flags"].append("shaker_on")  # no modal constant measured: not read
     elif start is not None:
@@ -236,6 +239,8 @@ def other_kinds_modal(rows: list[dict], records: dict, kind: str, swept: dict[st
         else:
             flags += r["flags"] + (r["dwell"]["fit"]["flags"] if r.get("dwell") else
                                    [] if r["flags"] else ["no_decay"]) + [UNUSABLE]
+        if r.get("receptance") is not None:  # what the decay was read through: the later stages read it alike
+            out.update(receptance_row(r["receptance"]))
         if w is not None and len(w):
             out["ringdown_windows"] = len(w)
             out["ringdown_decades"] = float(np.log10(w["q_in"].max() / w["q_in"].min()))
@@ -243,6 +248,28 @@ def other_kinds_modal(rows: list[dict], records: dict, kind: str, swept: dict[st
                    flags=";".join(dict.fromkeys(flags)))
         modal.append(out)
     return modal, points
+
+
+RECEPTANCE_COLUMNS = ("through_force_A_re", "through_force_A_im", "through_force_r0", "through_force_r2")
+
+
+def receptance_row(rc: Receptance) -> dict:
+    """The modal row's columns (`RECEPTANCE_COLUMNS`) of the `Receptance` a decay was read through the force with."""
+    return dict(zip(RECEPTANCE_COLUMNS, (rc.modal_constant.real, rc.modal_constant.imag, rc.r0, rc.r2)))
+
+
+def row_receptance(row) -> dict | None:
+    """The ``receptance`` argument of `read_test_run` from a modal row's `RECEPTANCE_COLUMNS` (keyed by its
+    ``mode_hz``, the frequency it was read at), or None where the run was not read through the force."""
+    vals = [row.get(c) for c in RECEPTANCE_COLUMNS]
+    f = row.get("mode_hz")
+    try:
+        vals, f = [float(v) for v in vals], float(f)
+    except (TypeError, ValueError):
+        return None
+    if not np.all(np.isfinite([*vals, f])):
+        return None
+    return {f: Receptance(complex(vals[0], vals[1]), vals[2], vals[3], source=str(row.get("run_id", "")))}
 
 
 def backbone_table(modal: pd.DataFrame, points: list[dict]) -> pd.DataFrame:

@@ -27,6 +27,7 @@ import pandas as pd
 from ..io import excitation_kind, listed_record, read_run, write_csv_atomic, write_json_atomic
 from .assembly import ValidateSettings, validate_runs
 from .models import models_from_samples, run_models
+from .testkinds import as_read
 from .drive import drive_gain, dwell_gain
 
 __all__ = ["run_validation"]
@@ -94,8 +95,7 @@ def run_validation(best_json: _Path, runs_csv: _Path, modal_csv: _Path, chain_np
     runs = pd.read_csv(runs_csv, dtype={"flags": str})
     modal_table = pd.read_csv(modal_csv)  # this (assembly, mode)'s rows
     modal = modal_table.set_index("run_id")
-    peak = modal["mode_peak_hz"] if "mode_peak_hz" in modal else pd.Series(dtype=float)
-    rows = [{**r, "mode_hz": peak.get(r["run_id"])} for r in runs[runs["run_id"].isin(modal.index)].to_dict("records")]
+    rows = as_read(runs[runs["run_id"].isin(modal.index)].to_dict("records"), modal_table)
     recs = [read_run(listed_record(str(r["file"]), list(records)), r) for r in rows]
     kind = excitation_kind(recs[0])
     gain = drive_gain(modal_table) if kind != "base" else None

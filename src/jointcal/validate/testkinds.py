@@ -22,14 +22,36 @@ import pandas as pd
 from ..io.contract import excitation_kind
 from ..io._kinds import DWELL, kind_of
 from ..measure.dwell import dwell_point
-from ..measure.testkinds import read_test_run
+from ..measure.testkinds import RECEPTANCE_COLUMNS, read_test_run, row_receptance
 from ..models import MinistackModel
 from .decay import compare_decay, decay_from_cut, decay_input
 from .drive import model_input, reference_column, response_to
 from .runs import run_head
 from .steady import compare_dwell
 
-__all__ = ["validate_test_run"]
+__all__ = ["validate_test_run", "as_read"]
+
+
+def as_read(rows: list[dict], modal: pd.DataFrame) -> list[dict]:
+    """The runs' rows with how the modal stage read each: ``mode_hz`` (its ``mode_peak_hz``) and, for a decay read
+    through the force, the modal constant and receptance it was read with (`RECEPTANCE_COLUMNS`), so that the
+    validation and the discrepancy stage read each record as the modal stage did.
+
+    Parameters
+    ----------
+    rows : list of dict
+        The runs' rows of runs.csv.
+    modal : DataFrame
+        Their rows of modal_properties.csv (``run_id``, ``mode_peak_hz``, the receptance columns where present).
+    """
+    m = modal.drop_duplicates("run_id").set_index("run_id")
+    cols = ["mode_peak_hz", *(c for c in RECEPTANCE_COLUMNS if c in m)] if "mode_peak_hz" in m else []
+    out = []
+    for r in rows:
+        got = m.loc[r["run_id"], cols] if r["run_id"] in m.index else pd.Series(dtype=float)
+        extra = {c: got.get(c) for c in cols[1:]}
+        out.append({**r, "mode_hz": got.get("mode_peak_hz"), **extra})
+    return out
 
 
 def _mode_hz(row: Mapping) -> float | None:
@@ -72,7 +94,7 @@ def validate_test_run(model: MinistackModel, record: pd.DataFrame, row: Mapping,
     head = {**run_head(row), "test": kind_of(row)}
     fs = float(row["sample_rate_hz"])
     kind = excitation_kind(record.columns)
-    read = read_test_run(row, record, kind, _mode_hz(row))
+    read = read_test_run(row, record, kind, _mode_hz(row), row_receptance(row))  # through the force as measured
     frames, metrics, notes, first = [], {}, [], None
     try:
         if read["point"] is not None:  # driven by the dwell's record (free from the decay's start, if it has one)
