@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["fit_window"]
+__all__ = ["fit_window", "fit_drifts"]
 
 
 def _basis(p: NDArray, t: NDArray, cubic: tuple[float, float] = (0.0, 0.0)) -> tuple[NDArray, NDArray, NDArray]:
@@ -99,13 +99,28 @@ def fit_window(t: NDArray, x: NDArray, w0: float, sigma0: float = 0.0, *,
     se_w : float
         The same for w, rad/s per unit white-noise rms.
     """
-    p, *_ = _gauss_newton(np.array([w0, sigma0, 0.0, 0.0]), t, x, free=2, cubic=cubic)
-    p, a, b, m, dm, B = _gauss_newton(p, t, x, free=4, cubic=cubic)
+    p, a, b, m, dm, B = _fit(t, x, w0, sigma0, cubic)
     J = np.column_stack([t * dm, -t * m, 0.5 * t * t * dm, -0.5 * t * t * m, B])
     try:
         cov = np.linalg.inv(J.T @ J)
         se, se_w = float(np.sqrt(cov[1, 1])), float(np.sqrt(cov[0, 0]))
     except np.linalg.LinAlgError:
         se = se_w = np.inf
-    misfit = float(np.sqrt(np.mean((x - m) ** 2)) / max(np.hypot(a, b) / np.sqrt(2), 1e-300))
-    return float(p[0]), float(p[1]), complex(a, b), misfit, se, se_w
+    return float(p[0]), float(p[1]), complex(a, b), _misfit(x, m, a, b), se, se_w
+
+
+def fit_drifts(t: NDArray, x: NDArray, w0: float) -> tuple[NDArray, complex, float]:
+    """`fit_window`'s fit, its drifts too: p = (w, sigma, r, s) (rad/s, 1/s, rad/s^2, 1/s^2) at the window's
+    centre, c = a + i b and the relative rms misfit (the decay's continuation, `jointcal.measure.ringdown`)."""
+    p, a, b, m, _, _ = _fit(t, x, w0, 0.0, (0.0, 0.0))
+    return p, complex(a, b), _misfit(x, m, a, b)
+
+
+def _fit(t, x, w0, sigma0, cubic):
+    """The constant model's fit, then the drifting one's from it."""
+    p, *_ = _gauss_newton(np.array([w0, sigma0, 0.0, 0.0]), t, x, free=2, cubic=cubic)
+    return _gauss_newton(p, t, x, free=4, cubic=cubic)
+
+
+def _misfit(x, m, a, b) -> float:
+    return float(np.sqrt(np.mean((x - m) ** 2)) / max(np.hypot(a, b) / np.sqrt(2), 1e-300))

@@ -16,7 +16,10 @@ The estimator (``ringdown_backbone``), in the order data flows:
    the band. The filter would smear the forced response before the cut into the decay's first periods
    (on the virtual Ministack +-8% in zeta over its first 7 periods), so the decay is filtered apart,
    preceded by `EXTEND` periods of its own continuation backwards: the damped sinusoid fitted to its
-   first window, raw and then once more band-passed. The first `SETTLE` period is left out (the
+   first window, raw and then once more band-passed, continued from the window's first sample with the
+   frequency and decay rate it has there (`_continued`: a softening mode's frequency rises 1% a period
+   after the cut from 5 g on the virtual Ministack, and continued at the window centre's frequency
+   the junction read the first window 0.05% low, noise-free). The first `SETTLE` period is left out (the
    drive's last sample above `DRIVE_OFF` lies within the DAQ filter's ring after the cut). Where the
    raw first window is not one damped sinusoid (its misfit above `MISFIT_MAX`: other modes ring from
    the start, as after an impact), one mode's continuation would start the others abruptly at the
@@ -68,11 +71,10 @@ f and 2.9% in zeta (36 decays, six seeds, before the third-order refit), where 6
 3 periods after the cut had read 0.69-0.80 decades: the noise floor's rule stopped them once a fixed
 window's decay rate was noisier than 1%, and the band-pass's smear of the cut cost the first 0.3
 decades. Cut from 5 g (tests/benchmarks/accept_testkinds.py, seeds 1-3, 18 decays, 1.65-2.13 decades)
-it reads f within 0.100% (the first window, 2.5 periods after the cut, -0.095 to -0.100%; on a
-first-harmonic slow flow cut from the same amplitude, noise-free, -0.05%: the continuation's junction
-with a decay whose frequency rises 1% a period; the exact decay's first periods after the cut add the
-rest) and zeta within 3.0% (the worst a window of 5 periods whose standard error is 0.87%: a 3.4-sigma
-excursion of the noise, which a rule of 1% per window allows in about one window of a few hundred).
+it reads f within 0.039% (before the continuation ran on at the junction's frequency and decay rate:
+0.100%, the first window, 2.5 periods after the cut, -0.095 to -0.100%) and zeta within 3.0% (the worst
+a window of 5 periods whose standard error is 0.87%: a 3.4-sigma excursion of the noise, which a rule of
+1% per window allows in about one window of a few hundred).
 """
 from __future__ import annotations
 
@@ -83,7 +85,7 @@ from scipy import signal
 
 from ..spectral import DRIVE_OFF, HOLD, drive_end, plateau_end
 from ..units import G
-from ._decay_window import fit_window
+from ._decay_window import fit_drifts, fit_window
 
 __all__ = ["decay_start", "ringdown_backbone", "ringdown_at", "slide_windows", "COLUMNS", "DRIVE_OFF", "HOLD", "BAND",
            "ZETA_SE_MAX", "MISFIT_MAX", "SETTLE", "TAIL", "MIN_CYCLES", "GROW", "SPAN_MAX", "EXTEND", "SETTLE_MIXED"]
@@ -150,15 +152,27 @@ def _band_passed_decay(x: NDArray, y: NDArray, i0: int, sos, n: int, fs: float, 
     raw decay's first window is not one damped sinusoid (its misfit above `MISFIT_MAX`: other modes ring from
     the start, and a continuation of this mode alone would start them abruptly at the junction)."""
     pad = int(round(EXTEND * fs / f_hz))
-    t_pad = (np.arange(-pad, 0) - (n - 1) / 2) / fs
     src = x
     for k in range(2):
-        w, sig, c, misfit, _, _ = fit_window(_centred(n, fs), src[i0:i0 + n], 2 * np.pi * f_hz)
+        p, c, misfit = fit_drifts(_centred(n, fs), src[i0:i0 + n], 2 * np.pi * f_hz)
         if k == 0 and misfit > MISFIT_MAX:
             return None
-        cont = np.exp(-sig * t_pad) * (c.real * np.cos(w * t_pad) + c.imag * np.sin(w * t_pad))
+        cont = _continued(p, c, n, pad, fs)
         src = np.concatenate([y[:i0], signal.sosfiltfilt(sos, np.concatenate([cont, x[i0:]]))[pad:]])
     return src
+
+
+def _continued(p: NDArray, c: complex, n: int, pad: int, fs: float) -> NDArray:
+    """The `pad` samples before a window of n samples: its damped sinusoid (`fit_drifts`: p = (w, sigma, r, s) at
+    the window's centre, c = a + i b) continued backwards from the window's first sample with the frequency and
+    decay rate it has there, so that phase, frequency, amplitude and decay rate run on across the junction (a
+    decay whose frequency rises 1% a period, continued at its centre's, is read -0.05% low in its first window)."""
+    w, sig, r, s = p
+    tj = -(n - 1) / 2 / fs  # the junction, on the window's centred clock
+    dt = np.arange(-pad, 0) / fs  # before the junction
+    phase = w * tj + 0.5 * r * tj * tj + (w + r * tj) * dt
+    env = np.exp(-sig * tj - 0.5 * s * tj * tj - (sig + s * tj) * dt)
+    return env * (c.real * np.cos(phase) + c.imag * np.sin(phase))
 
 
 COLUMNS = ["t_s", "window_s", "q_in", "f_hz", "zeta", "zeta_se", "f_se_hz", "misfit", "flags"]
