@@ -49,7 +49,8 @@ def _residual_axes(fig, axes, whats: tuple[str, str], units: str, xlabel: str, w
 
 def before_after_figure(frames_before: Mapping[str, pd.DataFrame], frames_after: Mapping[str, pd.DataFrame],
                         diagnosis: Mapping, path) -> None:
-    """Measured (solid), baseline (dashed) and corrected (dotted) response envelopes, one down sweep per level."""
+    """Measured (solid), baseline (dashed) and corrected (dotted) response envelopes of the sweeps; the frames of a
+    mixed campaign's ring-downs and dwells (no swept envelope) are passed over."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -58,13 +59,13 @@ def before_after_figure(frames_before: Mapping[str, pd.DataFrame], frames_after:
     cmap = plt.get_cmap("viridis", max(len(frames_after), 2))
     for i, rid in enumerate(sorted(frames_after)):
         a = frames_after[rid]
-        if not len(a):
+        if not len(a) or not {"f_hz", "resp_meas_g", "resp_sim_g"} <= set(a.columns):
             continue
         a = a.sort_values("f_hz")
         ax.semilogy(a["f_hz"], a["resp_meas_g"], "-", color=cmap(i), lw=1.2, label=rid)
         ax.semilogy(a["f_hz"], a["resp_sim_g"], ":", color=cmap(i), lw=1.4)
         b = frames_before.get(rid)
-        if b is not None and len(b):
+        if b is not None and len(b) and {"f_hz", "resp_sim_g"} <= set(b.columns):
             b = b.sort_values("f_hz")
             ax.semilogy(b["f_hz"], b["resp_sim_g"], "--", color=cmap(i), lw=1.0)
     ax.set_xlabel("drive frequency (Hz)", fontsize=10)
