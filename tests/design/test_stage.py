@@ -39,6 +39,9 @@ def test_force_driven_campaign_gets_words_instead_of_a_level(tmp_path):
     assert rec["applicable"] is False and rec["recommended"] is None and ranked.empty
     assert "force-driven" in rec["reason"] and "no level in lbf is recommended" in rec["reason"]
     assert "phi_max" in rec["what_would_identify"]
+    pm = table.set_index("quantity").loc["phi_max"]
+    assert not pm["identified"]  # the null draws leave macroslip to the bounds: no bound is quoted as a target
+    assert "until it exceeds" not in rec["what_would_identify"] and "search bounds" in rec["what_would_identify"]
     saved = json.loads((tmp_path / "design" / "next_test.json").read_text())
     assert saved["recommended"] is None and "No level recommended" in (tmp_path / "design" / "next_test.md").read_text()
 
@@ -64,3 +67,18 @@ def test_evaluate_and_run_design_on_a_base_driven_campaign_write_the_three_files
     assert len(ranked) == 5 * 2 * 2 and (tmp_path / "design" / "next_test.csv").is_file()
     md = (tmp_path / "design" / "next_test.md").read_text()
     assert "Recommended: a 100 g base sweep" in md and "Criterion:" in md and "Rule:" in md
+
+
+def test_the_words_past_macroslip_quote_a_target_amplitude_only_where_the_data_place_it():
+    """phi_max left to the bounds: no target amplitude (the issue's 'raise until q_in exceeds 0.625 in' when 0.9 in
+    had been measured); placed above the runs: its upper end; placed below the largest amplitude: no more level."""
+    import pandas as pd
+
+    from jointcal.design.stage import _past_macroslip
+
+    free = _past_macroslip(pd.Series({"identified": False, "q05": 0.0187, "q95": 1.53}), 0.008, "force")
+    above = _past_macroslip(pd.Series({"identified": True, "q05": 0.02, "q95": 0.05}), 0.008, "force")
+    below = _past_macroslip(pd.Series({"identified": True, "q05": 0.3, "q95": 0.625}), 0.9, "voltage")
+    assert "until it exceeds" not in free and "search bounds" in free and "power law" in free
+    assert "until it exceeds 0.05 in" in above
+    assert "until it exceeds" not in below and "already pass it" in below

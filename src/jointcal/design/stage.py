@@ -77,15 +77,30 @@ def _not_applicable(best: dict, identified: pd.DataFrame, assembly: str, q_max: 
               + (" and on the shaker's electrical and mechanical dynamics, which are in the calibrated mode"
                  if exc == "voltage" else "")
               + f", so no level in {unit} is recommended.")
-    need = (f"What would identify Fs and the KT/k split: a response amplitude q_in past macroslip. The posterior puts "
-            f"phi_max between {_g(pm['q05'])} and {_g(pm['q95'])} in (90%); the largest amplitude measured is "
-            f"{_g(q_max)} in. Raise the {exc} level in steps and read q_in from the modal stage until it exceeds "
-            f"{_g(pm['q95'])} in, or until the frequency and damping leave the power law of the lower levels.")
+    need = "What would identify Fs and the KT/k split: a response amplitude q_in past macroslip. " + _past_macroslip(
+        pm, q_max, exc)
     rec = {"assembly": assembly, "applicable": False, "recommended": None, "reason": reason, "what_would_identify": need,
            "phi_max_interval_in": [float(pm["q05"]), float(pm["q95"])], "largest_amplitude_in": q_max,
            "targets": targets_of(identified), "predicted_width_ratio": {}}
     md = f"# Next test: assembly {assembly}\n\n**No level recommended.** {reason}\n\n{need}\n"
     return rec, md
+
+
+def _past_macroslip(pm: pd.Series, q_max: float, exc: str) -> str:
+    """Where macroslip lies (phi_max, eq. 3.7: the identified table's row `pm`) and how to reach it, in words: a
+    target amplitude only where the data place phi_max, never an end the search bounds set."""
+    step = f"Raise the {exc} level in steps and read q_in from the modal stage"
+    if not bool(pm["identified"]):
+        return (f"The data do not place phi_max (eq. 3.7): its 90% range, {_g(pm['q05'])} to {_g(pm['q95'])} in, is "
+                f"what the search bounds leave; the largest amplitude measured is {_g(q_max)} in. {step} until the "
+                "frequency and damping leave the power law of the lower levels: there macroslip begins.")
+    if q_max >= pm["q95"]:
+        return (f"The posterior puts phi_max between {_g(pm['q05'])} and {_g(pm['q95'])} in (90%), below the largest "
+                f"amplitude measured ({_g(q_max)} in): the runs already pass it, and what they leave free is not for "
+                "want of amplitude (more levels near that range, or repeated runs, narrow it).")
+    return (f"The posterior puts phi_max between {_g(pm['q05'])} and {_g(pm['q95'])} in (90%); the largest amplitude "
+            f"measured is {_g(q_max)} in. {step} until it exceeds {_g(pm['q95'])} in, or until the frequency and "
+            "damping leave the power law of the lower levels.")
 
 
 def run_design(runs_csv: str | os.PathLike[str], modal_csv: str | os.PathLike[str],
