@@ -94,3 +94,25 @@ def read_out(folder: Path, truth_json: Path, ref: str, **modal_kw) -> pd.DataFra
                          q_err=props["q_in"] / q_t - 1, q_peak_err=props["q_peak_in"] / q_t - 1,
                          flags=props["flags"]))
     return pd.DataFrame(rows)
+
+
+def kinds_spec(ref: str, seed: int) -> tuple[dict, callable]:
+    """A campaign of the three test kinds (issue 31) on the rig driven by `ref` ('force' or 'voltage'): slow up
+    sweeps (eta 0.5) at the three levels, a ring-down cut off from a dwell at the top level's resonance, and five
+    dwells about the middle level's (each with its ring-down); 0.1% noise. Returns the synth spec and the truth's
+    curve q -> (f Hz, zeta) (`truth_curve`)."""
+    levels = levels_V()
+    f_top, z_top = truth_curve(ref, Q_TARGETS[2])
+    f_mid, z_mid = truth_curve(ref, Q_TARGETS[1])
+    rate = 0.5 * (f_mid * z_mid) ** 2
+    spec = {"seed": seed, "sample_rate_hz": 2048.0, "measurement": {"noise_fraction": 1e-3},
+            "sweep": {"f_start_hz": 0.7 * f_mid, "f_stop_hz": 1.3 * f_mid, "rate_hz_per_s": rate,
+                      "ramp_s": min(0.05, 0.02 * 0.6 * f_mid / rate), "tail_s": 1.5},
+            "series": [{"level_V": v, "directions": ["up"]} for v in levels]
+            + [{"level_V": levels[2], "test": "ringdown", "dwell_hz": [round(f_top, 3)], "dwell_s": 1.5,
+                "decay_s": 2.5},
+               {"level_V": levels[1], "test": "dwell", "dwell_s": 1.5, "decay_s": 2.5,
+                "dwell_hz": [round(f_mid * (1 + k * z_mid), 3) for k in (-1.0, -0.5, 0.0, 0.5, 1.0)]}],
+            "assemblies": {"beam": JOINTED_BEAM},
+            "rig": {"reference": ref, "shaker": SMALL_SHAKER, "second_mode": SECOND_MODE}}
+    return spec, lambda q: tuple(np.array([truth_curve(ref, v) for v in np.atleast_1d(q)]).T)

@@ -89,24 +89,6 @@ MINI = (FIRST["Fs"], FIRST["KT"], FIRST["chi"], FIRST["beta"], FIRST["k"], DEFAU
         FIRST["zeta_v"])
 
 
-def _beam_spec(ref: str, seed: int) -> tuple[dict, callable]:
-    levels = rigs.levels_V()
-    f_top, z_top = rigs.truth_curve(ref, rigs.Q_TARGETS[2])
-    f_mid, z_mid = rigs.truth_curve(ref, rigs.Q_TARGETS[1])
-    rate = 0.5 * (f_mid * z_mid) ** 2
-    spec = {"seed": seed, "sample_rate_hz": 2048.0, "measurement": {"noise_fraction": 1e-3},
-            "sweep": {"f_start_hz": 0.7 * f_mid, "f_stop_hz": 1.3 * f_mid, "rate_hz_per_s": rate,
-                      "ramp_s": min(0.05, 0.02 * 0.6 * f_mid / rate), "tail_s": 1.5},
-            "series": [{"level_V": v, "directions": ["up"]} for v in levels]
-            + [{"level_V": levels[2], "test": "ringdown", "dwell_hz": [round(f_top, 3)], "dwell_s": 1.5,
-                "decay_s": 2.5},
-               {"level_V": levels[1], "test": "dwell", "dwell_s": 1.5, "decay_s": 2.5,
-                "dwell_hz": [round(f_mid * (1 + k * z_mid), 3) for k in (-1.0, -0.5, 0.0, 0.5, 1.0)]}],
-            "assemblies": {"beam": rigs.JOINTED_BEAM},
-            "rig": {"reference": ref, "shaker": rigs.SMALL_SHAKER, "second_mode": rigs.SECOND_MODE}}
-    return spec, lambda q: tuple(np.array([rigs.truth_curve(ref, v) for v in np.atleast_1d(q)]).T)
-
-
 def _ministack_spec(seed: int) -> tuple[dict, callable]:
     spec = {"seed": seed, "assemblies": {"first": FIRST},
             "series": [{"level_g": lev, "directions": ["up"]} for lev in (1.0, 2.0, 5.0)]
@@ -172,8 +154,8 @@ def main() -> None:
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for seed in map(int, args.seeds.split(",")):
-            for name, (spec, truth) in (("beam force", _beam_spec("force", seed)),
-                                        ("beam voltage", _beam_spec("voltage", seed)),
+            for name, (spec, truth) in (("beam force", rigs.kinds_spec("force", seed)),
+                                        ("beam voltage", rigs.kinds_spec("voltage", seed)),
                                         ("ministack base", _ministack_spec(seed))):
                 if name not in args.rigs.split(","):
                     continue
