@@ -97,6 +97,9 @@ def test_validation_reads_the_ring_down_through_the_force_as_the_modal_stage_did
     assert m["n_windows"] >= 15 and m["decades"] >= 1.5
     assert abs(m["f_rel_err_mean"]) < 1e-3 and abs(m["zeta_rel_err_mean"]) < 0.03
     assert m["E_f"] < 2.0 and m["E_zeta"] < 2.0
+    # the record decays at the rig's rate (the shaker's damping added), the model at the structure's: their
+    # envelopes in time do not compare (10.6 dB apart at the end, measured), and none is given
+    assert np.isnan(m["env_end_db"])
     iw = model.iwan
     _, wrong = validate_test_run(replace(model, iwan=IwanParams(0.7 * iw.Fs, iw.KT, iw.chi, iw.beta)), record, row)
     # measured: f -0.17%, zeta +3.8%, E_f 31, E_zeta 6.9

@@ -84,3 +84,18 @@ def test_own_noise_needs_frames():
     fr = _frames(rng, 0.1, 0.5, n=12)
     sigma, dof = own_noise({"a": fr}, _metrics(["a"], [1.0], ["up"]).assign(n_frames=12))  # < 10 a bin and side
     assert (dof == 0).all() and np.isnan(sigma).all()
+
+
+def test_the_words_on_decays_read_through_the_force_compare_no_envelopes_in_time():
+    """A decay read through the force with the shaker attached decays at the rig's rate in the record and at the
+    structure's in the model: its metrics give no envelope difference (NaN), and the words say why instead of
+    'nan dB'; a free decay's envelope difference is given in dB."""
+    from jointcal.validate.error import describe_misfit
+
+    row = dict(run_id="r", test="ringdown", n_frames=12, n_windows=12, f_rel_err_mean=1e-4, zeta_rel_err_mean=-0.005,
+               q_first_meas_in=8e-3, decades=1.9, env_end_db=np.nan)
+    err = {"E": 1.3, "E_f": 1.1, "E_zeta": 1.5, "scale": [{"source": "own noise"}]}
+    forced = describe_misfit(pd.DataFrame([row]), err)
+    assert "envelopes in time are not compared" in forced and "nan" not in forced.lower()
+    free = describe_misfit(pd.DataFrame([{**row, "env_end_db": -0.4}]), err)
+    assert "decay envelope ends 0.40 dB below the measured" in free
