@@ -314,8 +314,7 @@ def build_parser() -> argparse.ArgumentParser:
               threads=True)
     p.add_argument("campaign_dir", metavar="CAMPAIGN_DIR", help="folder holding manifest.csv and the run files")
     files(p, "runs", "modal", "best", "chain", "assembly")
-    p = stage("discrepancy", _cmd_discrepancy, "name the effect the model misses (stage discrepancy)",
-              errors=(ValueError, KeyError), threads=True)
+    p = stage("discrepancy", _cmd_discrepancy, "name the effect the model misses (stage discrepancy)", threads=True)
     p.add_argument("campaign_dir", metavar="CAMPAIGN_DIR", help="folder holding manifest.csv and the run files")
     files(p, "runs", "modal", "envelopes", "best", "history", "validation", "assembly")
     p = stage("design", _cmd_design, "the next test of one unit (stage design)")

@@ -8,7 +8,7 @@ Snakemake prepends a preamble to scripts.)
 from jointcal._stage_job import stage_job
 from jointcal.discrepancy.stage import run_discrepancy
 
-with stage_job(snakemake, errors=(ValueError, KeyError)) as job:  # noqa: F821 (provided by Snakemake)
+with stage_job(snakemake) as job:  # noqa: F821 (provided by Snakemake)
     smk, asm = job.smk, job.smk.wildcards.assembly
     config = {k: getattr(smk.params, k) for k in ("discrepancy", "calibrate", "validate", "envelopes", "modal")}
     out = {k: getattr(smk.output, k) for k in ("diagnosis", "markdown", "residuals", "metrics_after",
