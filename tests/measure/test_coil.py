@@ -1,6 +1,7 @@
 """The voltage drive's coil in the sweep fit (jointcal.measure._coil): its pole, its sensitivities, its read-out."""
 from __future__ import annotations
 
+import functools
 from dataclasses import replace
 
 import numpy as np
@@ -62,9 +63,21 @@ def _linear_rig():
     return w_e, g, *(float(v) for v in coil_pole(om**2, 2 * 0.01 * om, w_e, g))
 
 
+@functools.cache
 def _linear_chirp(eta: float):
+    """The linear rig's voltage chirp at `eta`, integrated once per module (read only: both chirp tests read the
+    slow one and the fast one, the same records)."""
     w_e, g, f_t, z_t = _linear_rig()
-    return _voltage_chirp(100.0, 0.01, w_e, g, 60.0, 140.0, eta * (f_t * z_t) ** 2, 1024.0, 1.5)
+    v, acc = _voltage_chirp(100.0, 0.01, w_e, g, 60.0, 140.0, eta * (f_t * z_t) ** 2, 1024.0, 1.5)
+    v.flags.writeable = acc.flags.writeable = False
+    return v, acc
+
+
+@functools.cache
+def _slow_fit():
+    """The slow chirp (eta 0.5) fitted with its coil, once for the two tests that read it."""
+    _, _, f_t, z_t = _linear_rig()
+    return fit_swept_mode(*_linear_chirp(0.5), 1024.0, 1.01 * f_t, 1.3 * z_t, coil="fit")
 
 
 def test_a_voltage_chirp_read_with_its_coil_is_the_pole_of_the_cubic():
@@ -72,7 +85,7 @@ def test_a_voltage_chirp_read_with_its_coil_is_the_pole_of_the_cubic():
     pole of the cubic within 1e-4 in f and 1% in zeta; a fast one (eta 20) read with the rig's own coil held
     gives it within 1e-4 and 1%. A coil that is not a corner and a gain is refused."""
     w_e, g, f_t, z_t = _linear_rig()
-    slow = fit_swept_mode(*_linear_chirp(0.5), 1024.0, 1.01 * f_t, 1.3 * z_t, coil="fit")
+    slow = _slow_fit()
     assert slow.coil is not None
     assert slow.f_hz == pytest.approx(f_t, rel=1e-4) and slow.zeta == pytest.approx(z_t, rel=0.01)
     v, acc = _linear_chirp(20.0)
@@ -90,7 +103,7 @@ def test_the_coil_fitted_on_a_slow_sweep_reads_a_fast_one():
     """The linear rig: the fast chirp (eta 20) read with the coil its slow chirp (eta 0.5) fitted gives the
     cubic's pole within 3e-4 in f and 3% in zeta."""
     _, _, f_t, z_t = _linear_rig()
-    slow = fit_swept_mode(*_linear_chirp(0.5), 1024.0, 1.01 * f_t, 1.3 * z_t, coil="fit")
+    slow = _slow_fit()
     fast = fit_swept_mode(*_linear_chirp(20.0), 1024.0, 1.01 * f_t, 1.3 * z_t, coil=slow.coil)
     assert fast.f_hz == pytest.approx(f_t, rel=3e-4) and fast.zeta == pytest.approx(z_t, rel=0.03)
 
