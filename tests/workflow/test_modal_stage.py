@@ -36,9 +36,10 @@ def test_bad_runs_inside_a_valid_campaign_are_flagged_and_the_rest_finish(tmp_pa
     base = {"seed": 9, "sweep": {"f_start_hz": 1500.0, "f_stop_hz": 2700.0, "rate_hz_per_s": 400.0},
             "series": [{"level_g": 1.0, "directions": ["up", "down"]}], "assemblies": {"first": FIRST}}
     generate(base, tmp_path / "c", tmp_path / "t.json")
-    generate({**base, "sweep": {"f_start_hz": 700.0, "f_stop_hz": 1500.0, "rate_hz_per_s": 400.0}},
-             tmp_path / "low", tmp_path / "t2.json")
-    generate({**base, "measurement": {"full_scale_g": {"base": "auto", "response": 10.0}}},
+    up = [{"level_g": 1.0, "directions": ["up"]}]  # the two donors' up runs only: byte-identical to the first run
+    generate({**base, "series": up, "sweep": {"f_start_hz": 700.0, "f_stop_hz": 1500.0, "rate_hz_per_s": 400.0}},
+             tmp_path / "low", tmp_path / "t2.json")  # of the up-and-down campaign (checked), and only it is merged
+    generate({**base, "series": up, "measurement": {"full_scale_g": {"base": "auto", "response": 10.0}}},
              tmp_path / "clip", tmp_path / "t3.json")
     _merge_run(tmp_path / "c", tmp_path / "low", "first_01_1g_up", "low_band", 3)
     _merge_run(tmp_path / "c", tmp_path / "clip", "first_01_1g_up", "clipped", 4)
