@@ -18,48 +18,67 @@ holds them fixed (`cubic`), which costs no parameter; the t^4 terms left are eve
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 from numpy.typing import NDArray
 
 __all__ = ["fit_window", "fit_drifts"]
 
 
-def _basis(p: NDArray, t: NDArray, cubic: tuple[float, float] = (0.0, 0.0)) -> tuple[NDArray, NDArray, NDArray]:
-    w, sig, r, s = p
-    t3 = t * t * t
-    env = np.exp(-sig * t - 0.5 * s * t * t + cubic[1] * t3)
-    ph = w * t + 0.5 * r * t * t + cubic[0] * t3
-    return env, ph, np.column_stack([env * np.cos(ph), env * np.sin(ph)])
+@njit(cache=True)
+def _project(p: NDArray, t: NDArray, x: NDArray, c0: float, c1: float):
+    """a, b, the model, d(model)/d(phase) and the basis B (n, 2) at the nonlinear parameters p (w, sigma, r, s),
+    the phase's and the log-envelope's third-order terms c0, c1 held."""
+    n = t.size
+    B = np.empty((n, 2))
+    env = np.empty(n)
+    ph = np.empty(n)
+    for i in range(n):
+        ti = t[i]
+        t3 = ti * ti * ti
+        env[i] = np.exp(-p[1] * ti - 0.5 * p[3] * ti * ti + c1 * t3)
+        ph[i] = p[0] * ti + 0.5 * p[2] * ti * ti + c0 * t3
+        B[i, 0] = env[i] * np.cos(ph[i])
+        B[i, 1] = env[i] * np.sin(ph[i])
+    ab = np.linalg.lstsq(B, x)[0]
+    a, b = ab[0], ab[1]
+    m = B[:, 0] * a + B[:, 1] * b
+    dm = env * (-a * np.sin(ph) + b * np.cos(ph))
+    return a, b, m, dm, B
 
 
-def _project(p: NDArray, t: NDArray, x: NDArray, cubic: tuple[float, float] = (0.0, 0.0)):
-    """a, b, the model, d(model)/d(phase) and the basis at the nonlinear parameters p."""
-    env, ph, B = _basis(p, t, cubic)
-    (a, b), *_ = np.linalg.lstsq(B, x, rcond=None)
-    return a, b, B @ [a, b], env * (-a * np.sin(ph) + b * np.cos(ph)), B
-
-
-def _gauss_newton(p: NDArray, t: NDArray, x: NDArray, free: int, iters: int = 40,
-                  cubic: tuple[float, float] = (0.0, 0.0)):
+@njit(cache=True)
+def _gauss_newton(p: NDArray, t: NDArray, x: NDArray, free: int, c0: float, c1: float, iters: int = 40):
     """Minimise |x - model|^2 over the first `free` of (w, sigma, r, s), step halving on an increase."""
-    a, b, m, dm, B = _project(p, t, x, cubic)
-    cost = float(np.sum((x - m) ** 2))
+    a, b, m, dm, B = _project(p, t, x, c0, c1)
+    cost = np.sum((x - m) ** 2)
+    n = t.size
     for _ in range(iters):
-        J = np.column_stack([t * dm, -t * m, 0.5 * t * t * dm, -0.5 * t * t * m])[:, :free]
-        scale = np.linalg.norm(J, axis=0)
-        scale[scale == 0] = 1.0
-        step, *_ = np.linalg.lstsq(J / scale, x - m, rcond=None)
-        step = np.concatenate([step / scale, np.zeros(4 - free)])
+        J = np.empty((n, free))
+        for i in range(n):
+            cols = (t[i] * dm[i], -t[i] * m[i], 0.5 * t[i] * t[i] * dm[i], -0.5 * t[i] * t[i] * m[i])
+            for j in range(free):
+                J[i, j] = cols[j]
+        scale = np.sqrt(np.sum(J * J, axis=0))
+        for j in range(free):
+            if scale[j] == 0.0:
+                scale[j] = 1.0
+        sol = np.linalg.lstsq(J / scale, x - m)[0] / scale
+        step = np.zeros(4)
+        step[:free] = sol
         lam = 1.0
+        accepted = False
         while lam > 1e-4:
-            trial = _project(p + lam * step, t, x, cubic)
-            new = float(np.sum((x - trial[2]) ** 2))
+            ta, tb, tm, tdm, tB = _project(p + lam * step, t, x, c0, c1)
+            new = np.sum((x - tm) ** 2)
             if new <= cost:
+                accepted = True
                 break
             lam /= 2
-        else:
+        if not accepted:
             break
         done = cost - new <= 1e-12 * cost
-        p, (a, b, m, dm, B), cost = p + lam * step, trial, new
+        p = p + lam * step
+        a, b, m, dm, B, cost = ta, tb, tm, tdm, tB, new
         if done:
             break
     return p, a, b, m, dm, B
@@ -117,9 +136,11 @@ def fit_drifts(t: NDArray, x: NDArray, w0: float) -> tuple[NDArray, complex, flo
 
 
 def _fit(t, x, w0, sigma0, cubic):
-    """The constant model's fit, then the drifting one's from it."""
-    p, *_ = _gauss_newton(np.array([w0, sigma0, 0.0, 0.0]), t, x, free=2, cubic=cubic)
-    return _gauss_newton(p, t, x, free=4, cubic=cubic)
+    """The constant model's fit, then the drifting one's from it (the numba kernels above)."""
+    t, x = np.ascontiguousarray(t, dtype=float), np.ascontiguousarray(x, dtype=float)
+    c0, c1 = float(cubic[0]), float(cubic[1])
+    p, *_ = _gauss_newton(np.array([float(w0), float(sigma0), 0.0, 0.0]), t, x, 2, c0, c1)
+    return _gauss_newton(p, t, x, 4, c0, c1)
 
 
 def _misfit(x, m, a, b) -> float:
