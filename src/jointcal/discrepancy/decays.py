@@ -29,7 +29,7 @@ which capped a right name at confidence medium.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
@@ -40,6 +40,7 @@ from ..io import level_column
 from ..io.contract import UNUSABLE
 from ..models.free_decay import free_backbone
 from ..validate.decay import scales
+from .decay_readout import Factor, readout_factor
 from .fit import Candidate, Fit, least_squares_fit, model_at
 
 __all__ = ["DecayRun", "DecayObjective", "decay_runs", "decay_folds", "read_scatter", "BANDS", "MIN_WINDOWS"]
@@ -54,7 +55,9 @@ class DecayRun:
 
     q_in : amplitude read, in; f_hz : frequency, Hz; zeta : damping ratio; sigma_f, sigma_zeta : relative
     scatter of f and zeta; row : the manifest/modal row (run_id, its level, sequence, test); level : the
-    run's level in its own unit; band : the amplitude band's label ('' for the whole run).
+    run's level in its own unit; band : the amplitude band's label ('' for the whole run); record : the run's
+    measured record (time_s, reference, response_accel_g; g), for its simulated read-out
+    (`decay_readout`), None without it.
     """
 
     q_in: NDArray[np.float64]
@@ -65,6 +68,7 @@ class DecayRun:
     row: dict
     level: float = float("nan")
     band: str = ""
+    record: pd.DataFrame | None = field(default=None, compare=False, repr=False)
 
     @property
     def run_id(self) -> str:
@@ -136,7 +140,8 @@ def _own_se(q: NDArray, f: NDArray, z: NDArray, windows: pd.DataFrame | None) ->
 
 def decay_runs(backbone: pd.DataFrame, modal: pd.DataFrame, rows: Sequence[Mapping], *, floor_db: float = 0.05,
                floor_deg: float = 0.3, bands: int = BANDS,
-               se: Mapping[str, pd.DataFrame] | None = None) -> list[DecayRun]:
+               se: Mapping[str, pd.DataFrame] | None = None,
+               records: Mapping[str, pd.DataFrame] | None = None) -> list[DecayRun]:
     """The assembly's backbone points as `DecayRun` pieces (each run split into amplitude bands).
 
     Parameters
@@ -154,6 +159,9 @@ def decay_runs(backbone: pd.DataFrame, modal: pd.DataFrame, rows: Sequence[Mappi
     se : mapping run_id -> DataFrame, optional
         Each ring-down's windows read again from its record (q_in, f_hz, zeta, f_se_hz, zeta_se): the
         read-out's own standard errors; a run without them takes the pooled scatter (`read_scatter`).
+    records : mapping run_id -> DataFrame, optional
+        Each run's measured record, kept on its pieces for the read-out factor (`decay_readout`); a dwell's
+        phase resonance has none (a steady point, not a decay).
     """
     pts = _points(backbone, modal, rows)
     if not pts:
@@ -174,7 +182,7 @@ def decay_runs(backbone: pd.DataFrame, modal: pd.DataFrame, rows: Sequence[Mappi
             i = b == k
             lo, hi = np.exp(edges[k]), np.exp(edges[k + 1])
             out.append(DecayRun(q[i], f[i], z[i], s_f[i], s_z[i], row, float(row[col]) if col else float("nan"),
-                                f"q {lo:.2g} to {hi:.2g} in"))
+                                f"q {lo:.2g} to {hi:.2g} in", (records or {}).get(str(row["run_id"]))))
     return out
 
 
@@ -198,39 +206,68 @@ def decay_folds(runs: Sequence[DecayRun]) -> dict[str, list[int]]:
 
 @dataclass(frozen=True)
 class DecayObjective:
-    """A candidate on one assembly's backbone points: E, its residuals, the prediction, the fit.
+    """A candidate on one assembly's backbone points, linearised at theta_ref: E, its residuals, the prediction,
+    the fit.
 
-    The model's points are its free-decay backbone at the measured amplitudes (`free_backbone`), batched
-    over parameter sets. The same interface as the sweeps' `fit.Objective` (`at`, `subset`, `predict`,
-    `residuals`, `E`, `fit`), so `select` scores and `recalibrate` recalibrates it the same way; a decay
-    has no transient to refresh (`at` returns it unchanged).
+    The model's points are its free-decay backbone at the measured amplitudes (`free_backbone`), batched over
+    parameter sets, times each piece's read-out factor taken at theta_ref (`decay_readout`, R1-R2: the
+    estimator's read-out of the candidate's simulated decay over its backbone). The same interface as the
+    sweeps' `fit.Objective` (`at`, `subset`, `predict`, `residuals`, `E`, `fit`), so `select` scores and
+    `recalibrate` recalibrates it the same way; the factor is the objective's, retaken in one place (`at`).
+
+    Attributes
+    ----------
+    candidate : Candidate
+    runs : tuple of DecayRun
+    factor : tuple of (k_f, k_zeta) or None
+        Each piece's read-out factor at theta_ref, arrays of its points' shape (None: 1, the backbone alone).
+    theta_ref : ndarray or None
+        Where the factors were taken (None: nowhere, every factor 1).
     """
 
     candidate: Candidate
     runs: tuple[DecayRun, ...]
+    factor: tuple[Factor, ...] = ()
+    theta_ref: NDArray[np.float64] | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "runs", tuple(self.runs))
+        if not self.factor:
+            object.__setattr__(self, "factor", (None,) * len(self.runs))
 
     def at(self, theta: NDArray) -> DecayObjective:
-        return self
+        """The same candidate and points linearised at theta (n,): every piece's read-out factor taken there
+        (each run's decay simulated from its record's cut and read, `decay_readout.readout_factor`)."""
+        th = np.asarray(theta, dtype=float)
+        if self.theta_ref is not None and np.array_equal(th, self.theta_ref):
+            return self
+        return DecayObjective(self.candidate, self.runs, readout_factor(self.candidate, th, self.runs), th)
 
     def subset(self, idx: Sequence[int]) -> DecayObjective:
-        return DecayObjective(self.candidate, tuple(self.runs[i] for i in idx))
+        """The objective on the pieces `idx` (their factors kept)."""
+        return DecayObjective(self.candidate, tuple(self.runs[i] for i in idx), tuple(self.factor[i] for i in idx),
+                              self.theta_ref)
 
     def predict(self, theta: NDArray, i: int) -> tuple[NDArray, NDArray]:
-        """Run piece i's (f Hz, zeta) at its amplitudes, (P, n) or (n,)."""
-        run = self.runs[i]
-        return free_backbone(model_at(self.candidate, theta, run.row), run.q_in)
+        """Run piece i's (f Hz, zeta) at its amplitudes as the read-out shows them (R2), (P, n) or (n,)."""
+        run, k = self.runs[i], self.factor[i]
+        f, z = free_backbone(model_at(self.candidate, theta, run.row), run.q_in)
+        return (f, z) if k is None else (f * k[0], z * k[1])
 
     def points(self, theta: NDArray) -> tuple[NDArray, NDArray]:
-        """(f, zeta) at every piece's amplitudes, concatenated: one call for a model that does not change
-        with the run's place in the sequence."""
+        """(f, zeta) at every piece's amplitudes, concatenated (R2): one backbone call for a model that does not
+        change with the run's place in the sequence."""
         if self.candidate.sequence_dependent:
             parts = [self.predict(theta, i) for i in range(len(self.runs))]
             return np.concatenate([p[0] for p in parts], axis=-1), np.concatenate([p[1] for p in parts], axis=-1)
         q = np.concatenate([r.q_in for r in self.runs])
-        return free_backbone(model_at(self.candidate, theta, self.runs[0].row), q)
+        f, z = free_backbone(model_at(self.candidate, theta, self.runs[0].row), q)
+        if all(k is None for k in self.factor):
+            return f, z
+        ones = lambda r, k, j: np.ones(r.q_in.size) if k is None else k[j]  # noqa: E731
+        kf = np.concatenate([ones(r, k, 0) for r, k in zip(self.runs, self.factor)])
+        kz = np.concatenate([ones(r, k, 1) for r, k in zip(self.runs, self.factor)])
+        return f * kf, z * kz
 
     def residuals(self, theta: NDArray) -> NDArray:
         """Residual vector whose sum of squares is E^2 (theta (n,) -> (m,), (P, n) -> (P, m))."""
@@ -250,9 +287,18 @@ class DecayObjective:
 
     def fit(self, theta0: NDArray, *, starts: int = 3, max_nfev: int = 60, free_joint: bool = True,
             refresh: int = 0) -> Fit:
-        """Bounded least squares over the candidate's unit cube, as `fit.Objective.fit` (refresh: nothing to
-        retake)."""
+        """Bounded least squares over the candidate's unit cube, as `fit.Objective.fit`.
+
+        refresh : times the read-out factor is retaken (at theta0 first, then at each optimum, refitting from
+        it); 0 keeps this objective's factors.
+        """
         space = self.candidate.grown
         given = dict(zip(space.names, map(float, theta0)))
         th0 = space.vector(given, default={p.name: p.start for p in self.candidate.effect_params})
+        if refresh:
+            fit = self.at(th0).fit(th0, starts=starts, max_nfev=max_nfev, free_joint=free_joint)
+            for _ in range(refresh):
+                again = self.at(fit.theta).fit(fit.theta, starts=1, max_nfev=max_nfev, free_joint=free_joint)
+                fit = replace(again, n_eval=again.n_eval + fit.n_eval)
+            return fit
         return least_squares_fit(self, th0, given, starts, max_nfev, free_joint)
