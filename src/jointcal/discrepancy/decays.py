@@ -2,7 +2,11 @@
 
 A free decay follows the model's backbone (`jointcal.models.free_decay.free_backbone`: the first harmonic
 of the model with every element an effect adds, omega^2 = Re K(q) / m, zeta = Im K / (2 Re K)), so a
-candidate predicts each measured point of a ring-down, f(q) and zeta(q), at its amplitude q. The points
+candidate predicts each measured point of a ring-down, f(q) and zeta(q), at its amplitude q, times the point's
+read-out factor (`decay_readout`: the estimator's read-out of the candidate's simulated decay over its backbone,
+taken at a reference parameter set and retaken at each optimum, as the sweeps' transient factor): near the
+joint's macroslip knee f and zeta change within a window, and the validation compares the read-out, not the
+backbone. The points
 are the modal stage's (``backbone.csv``): every ring-down window (a dwell's own ring-down too), and each
 level's dwells once by their phase resonance (``q_dwell_quad_in``, ``f_dwell_quad_hz``, ``zeta_dwell_quad``
 of ``modal_properties.csv``, as the calibration takes them).
