@@ -3,18 +3,22 @@
 0. Points and floor: the backbone points of every ring-down and each level's dwells (`decays.decay_runs`),
    scaled by the read-out's own standard errors (the ring-downs read again from their records, `read_again`),
    each run's record kept for the read-out factor (`decay_readout`: the candidate's simulated decay read by the
-   estimator, over its backbone; taken at each fit's start and optimum). The fast model's floor F is the
-   baseline's backbone times the factor its held-out folds used (taken at its refit) against the calibrated
-   model's time simulation read by the same estimator at the same windows (the validation's frames:
-   `jointcal.validate.decay`), in the same E: what the linearised fast model misses of the time simulation
-   over the baseline's refit step (with the factor taken at the calibration itself it would be 0 by
-   construction). The backbone alone against the same frames is reported beside it (``backbone_E``).
+   estimator, over its backbone; taken at each fit's start and optimum). With the factor taken at theta the
+   fast model is the time simulation's read-out at theta (the validation's compared frames,
+   `jointcal.validate.decay`), so its floor F is what the linearisation misses where the scores are taken
+   (`fold_floor`): the baseline's fast model, its factor taken at its fit on all runs, against the time
+   simulation's read-out at each held-out fold's refit, on that fold, in the same E. The backbone alone against
+   the calibrated model's time simulation (the floor before the factor) is reported beside it
+   (``backbone_at_calibration``).
 1. Candidates: the baseline and every library effect a decay can show. An effect whose parameters do not
    change the backbone (a channel delay: a free decay has no phase against a drive; a neighbouring mode: the
    read-out band-passes the mode) or that has none (a flexible fixture: no one-DOF backbone) is not tried,
    and the diagnosis says so (``not_seen_by_decays``): it must not be named from decays.
-2. Each refit on the points (`decays.DecayObjective`), scored on held-out runs (amplitude bands on request)
-   (`decays.decay_folds`, `select.score_candidates`); pairs by forward selection when the rule asks.
+2. Each refit on the points (`decays.DecayObjective`, the read-out factor retaken at each optimum) from the
+   calibration and from its other valleys (``joint_starts``: beta is held, and the Iwan alone made to follow a
+   hardening backbone sits with its macroslip knee at the top amplitude, a valley a hidden stiffening's model
+   does not share), scored on held-out runs (amplitude bands on request) (`decays.decay_folds`,
+   `select.score_candidates`); pairs by forward selection when the rule asks.
 3. Decide by `rule.decide` with F; 4. recalibrate the named (or baseline) model by the calibration's GA and
    the posterior in the grown space (`recalibrate`); revalidate every run by the time simulation
    (`jointcal.validate.validate_runs`: the decays from the record's state at the cut) -> E before and after,
