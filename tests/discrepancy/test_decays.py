@@ -93,7 +93,7 @@ def test_ring_downs_alone_name_the_hidden_effect(tmp_path, effect, params):
     truth = json.loads((tmp_path / "truth.json").read_text())["effect"]
     assert truth["name"] == effect and d["data"] == "decays"
     assert set(d["not_seen_by_decays"]) == {"channel_delay", "neighbour_mode"}
-    assert d["fast_model_floor"]["E"] < 0.5  # the backbone against the time simulation of the same model
+    assert d["fast_model_floor"]["E"] < 0.5  # the linearised fast model against the time simulation at the folds
     assert d["effect"] == effect and d["confidence"] == "high", d["rule_applied"]
     if effect == "none":
         assert d["metric_after"] < 1.5
