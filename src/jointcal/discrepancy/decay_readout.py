@@ -50,7 +50,8 @@ def simulated_readout(c: Candidate, theta: NDArray, run: DecayRun) -> pd.DataFra
     """
     if run.record is None:
         return None
-    frames, _ = validate_test_run(model_at(c, np.asarray(theta, dtype=float), run.row), run.record, run.row)
+    frames, _ = validate_test_run(model_at(c, np.asarray(theta, dtype=float), run.row), run.record, run.row,
+                                  read=run.read)
     if frames.empty or "part" not in frames:
         return None
     fr = frames[(frames["part"] == "ringdown") & frames["in_range"].astype(bool)]

@@ -44,6 +44,7 @@ from ..io import level_column
 from ..io.contract import UNUSABLE
 from ..models.free_decay import free_backbone
 from ..validate.decay import scales
+from ..validate.testkinds import measured_read
 from .decay_readout import Factor, readout_factor
 from .fit import Candidate, Fit, least_squares_fit, model_at
 
@@ -61,7 +62,8 @@ class DecayRun:
     scatter of f and zeta; row : the manifest/modal row (run_id, its level, sequence, test); level : the
     run's level in its own unit; band : the amplitude band's label ('' for the whole run); record : the run's
     measured record (time_s, reference, response_accel_g; g), for its simulated read-out
-    (`decay_readout`), None without it.
+    (`decay_readout`), None without it; read : the record's `measured_read` (the measured windows the
+    validation compares with), read once.
     """
 
     q_in: NDArray[np.float64]
@@ -73,6 +75,7 @@ class DecayRun:
     level: float = float("nan")
     band: str = ""
     record: pd.DataFrame | None = field(default=None, compare=False, repr=False)
+    read: Mapping | None = field(default=None, compare=False, repr=False)
 
     @property
     def run_id(self) -> str:
@@ -168,6 +171,8 @@ def decay_runs(backbone: pd.DataFrame, modal: pd.DataFrame, rows: Sequence[Mappi
         phase resonance has none (a steady point, not a decay).
     """
     pts = _points(backbone, modal, rows)
+    reads = {str(r["run_id"]): measured_read(records[str(r["run_id"])], r) for r in rows
+             if str(r["run_id"]) in (records or {})}
     if not pts:
         return []
     sf, sz = read_scatter([(p["q_in"].to_numpy(), p["f_hz"].to_numpy(), p["zeta"].to_numpy()) for _, p in pts])
@@ -186,7 +191,8 @@ def decay_runs(backbone: pd.DataFrame, modal: pd.DataFrame, rows: Sequence[Mappi
             i = b == k
             lo, hi = np.exp(edges[k]), np.exp(edges[k + 1])
             out.append(DecayRun(q[i], f[i], z[i], s_f[i], s_z[i], row, float(row[col]) if col else float("nan"),
-                                f"q {lo:.2g} to {hi:.2g} in", (records or {}).get(str(row["run_id"]))))
+                                f"q {lo:.2g} to {hi:.2g} in", (records or {}).get(str(row["run_id"])),
+                                reads.get(str(row["run_id"]))))
     return out
 
 

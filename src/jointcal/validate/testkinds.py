@@ -29,7 +29,7 @@ from .drive import model_input, reference_column, response_to
 from .runs import run_head
 from .steady import compare_dwell
 
-__all__ = ["validate_test_run", "as_read"]
+__all__ = ["validate_test_run", "measured_read", "as_read"]
 
 
 def as_read(rows: list[dict], modal: pd.DataFrame) -> list[dict]:
@@ -63,8 +63,15 @@ def _mode_hz(row: Mapping) -> float | None:
         return None
 
 
+def measured_read(record: pd.DataFrame, row: Mapping) -> dict:
+    """The run's record read as the modal stage read it (`jointcal.measure.testkinds.read_test_run` at the row's
+    ``mode_hz``, through the force as measured): its dwell point, decay windows, start and flags. It does not depend
+    on the model: a caller that validates many models against one record reads it once."""
+    return read_test_run(row, record, excitation_kind(record.columns), _mode_hz(row), row_receptance(row))
+
+
 def validate_test_run(model: MinistackModel, record: pd.DataFrame, row: Mapping, *, floor_db: float = 0.05,
-                      floor_deg: float = 0.3) -> tuple[pd.DataFrame, dict]:
+                      floor_deg: float = 0.3, read: Mapping | None = None) -> tuple[pd.DataFrame, dict]:
     """One dwell or ring-down run: the model's dwell point and decay against the measured ones.
 
     Parameters
@@ -78,6 +85,8 @@ def validate_test_run(model: MinistackModel, record: pd.DataFrame, row: Mapping,
         the frequency the modal stage read it at; ``drive_gain`` for a force or voltage reference).
     floor_db, floor_deg : float
         The sweeps' floors of magnitude (dB) and phase (deg) (`ValidateSettings`).
+    read : mapping, optional
+        The record's `measured_read` (read here when None).
 
     Returns
     -------
@@ -94,7 +103,7 @@ def validate_test_run(model: MinistackModel, record: pd.DataFrame, row: Mapping,
     head = {**run_head(row), "test": kind_of(row)}
     fs = float(row["sample_rate_hz"])
     kind = excitation_kind(record.columns)
-    read = read_test_run(row, record, kind, _mode_hz(row), row_receptance(row))  # through the force as measured
+    read = measured_read(record, row) if read is None else read
     frames, metrics, notes, first = [], {}, [], None
     try:
         if read["point"] is not None:  # driven by the dwell's record (free from the decay's start, if it has one)
