@@ -22,8 +22,7 @@ validation's `BEYOND`), a dwell's phase resonance, or a run the simulation refus
 """
 from __future__ import annotations
 
-from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pandas as pd
@@ -33,25 +32,23 @@ from ..models.free_decay import free_backbone
 from ..validate.testkinds import validate_test_run
 from .fit import Candidate, model_at
 
-if TYPE_CHECKING:
-    from .decays import DecayRun
-
 __all__ = ["Factor", "simulated_readout", "factor_at", "readout_factor"]
 
 Factor = tuple[NDArray[np.float64], NDArray[np.float64]] | None  # (k_f, k_zeta) at a piece's points, None: 1
 
 
-def simulated_readout(c: Candidate, theta: NDArray, run: DecayRun) -> pd.DataFrame | None:
-    """The candidate's simulated ring-down of the run at theta (n,), read as the validation reads it.
+def simulated_readout(c: Candidate, theta: NDArray, record: pd.DataFrame | None, row: Mapping,
+                      read: Mapping | None = None) -> pd.DataFrame | None:
+    """The candidate's simulated ring-down of a run at theta (n,), read as the validation reads it.
 
+    record, row : the run's measured record and its row; read : the record's `measured_read` (read here when None).
     Returns the validation's compared windows (`jointcal.validate.validate_test_run`, ``part`` 'ringdown',
     in range and finite: q_meas_in (in), f_sim_hz (Hz), zeta_sim (-)), None when the run has no record or the
     simulation could not be compared.
     """
-    if run.record is None:
+    if record is None:
         return None
-    frames, _ = validate_test_run(model_at(c, np.asarray(theta, dtype=float), run.row), run.record, run.row,
-                                  read=run.read)
+    frames, _ = validate_test_run(model_at(c, np.asarray(theta, dtype=float), row), record, row, read=read)
     if frames.empty or "part" not in frames:
         return None
     fr = frames[(frames["part"] == "ringdown") & frames["in_range"].astype(bool)]
@@ -60,14 +57,14 @@ def simulated_readout(c: Candidate, theta: NDArray, run: DecayRun) -> pd.DataFra
     return fr[ok] if ok.any() else None
 
 
-def factor_at(c: Candidate, theta: NDArray, run: DecayRun, read: pd.DataFrame | None) -> Factor:
-    """The read-out factor (R1) at the run piece's amplitudes from its simulated read-out `read`
+def factor_at(c: Candidate, theta: NDArray, row: Mapping, q_in: NDArray, read: pd.DataFrame | None) -> Factor:
+    """The read-out factor (R1) at amplitudes q_in (in, (n,)) of the run `row` from its simulated read-out `read`
     (`simulated_readout` at the same theta): k_f, k_zeta, shape (n,); 1 outside the read windows' amplitudes,
     None without a read-out."""
     if read is None:
         return None
     q = read["q_meas_in"].to_numpy(float)
-    f_bb, z_bb = free_backbone(model_at(c, np.asarray(theta, dtype=float), run.row), q)
+    f_bb, z_bb = free_backbone(model_at(c, np.asarray(theta, dtype=float), row), q)
     with np.errstate(all="ignore"):
         kf, kz = read["f_sim_hz"].to_numpy(float) / f_bb, read["zeta_sim"].to_numpy(float) / z_bb
     ok = np.isfinite(kf) & np.isfinite(kz) & (kf > 0) & (kz > 0)
@@ -75,16 +72,17 @@ def factor_at(c: Candidate, theta: NDArray, run: DecayRun, read: pd.DataFrame | 
         return None
     o = np.argsort(np.log(q[ok]))
     lq = np.log(q[ok])[o]
-    x = np.log(run.q_in)
+    x = np.log(np.asarray(q_in, dtype=float))
     inside = (x >= lq[0] - 1e-9) & (x <= lq[-1] + 1e-9)
     at = lambda k: np.where(inside, np.interp(x, lq, k[ok][o]), 1.0)  # noqa: E731
     return at(kf), at(kz)
 
 
-def readout_factor(c: Candidate, theta: NDArray, runs: Sequence[DecayRun]) -> tuple[Factor, ...]:
-    """Every run piece's read-out factor (R1) at theta (n,): each run simulated and read once (its pieces share it)."""
+def readout_factor(c: Candidate, theta: NDArray, runs: Sequence) -> tuple[Factor, ...]:
+    """Every run piece's read-out factor (R1) at theta (n,): each run simulated and read once (its pieces share it).
+    runs : the pieces (`decays.DecayRun`: run_id, row, q_in, record, read)."""
     reads: dict[str, pd.DataFrame | None] = {}
     for r in runs:
         if r.run_id not in reads:
-            reads[r.run_id] = simulated_readout(c, theta, r)
-    return tuple(factor_at(c, theta, r, reads[r.run_id]) for r in runs)
+            reads[r.run_id] = simulated_readout(c, theta, r.record, r.row, r.read)
+    return tuple(factor_at(c, theta, r.row, r.q_in, reads[r.run_id]) for r in runs)
