@@ -33,7 +33,7 @@ which capped a right name at confidence medium.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -46,7 +46,7 @@ from ..models.free_decay import free_backbone
 from ..validate.decay import scales
 from ..validate.testkinds import measured_read
 from .decay_readout import Factor, readout_factor
-from .fit import Candidate, Fit, least_squares_fit, model_at
+from .fit import Candidate, Fit, model_at, refreshed_fit
 
 __all__ = ["DecayRun", "DecayObjective", "decay_runs", "decay_folds", "read_scatter", "BANDS", "MIN_WINDOWS"]
 
@@ -302,13 +302,4 @@ class DecayObjective:
         refresh : times the read-out factor is retaken (at theta0 first, then at each optimum, refitting from
         it); 0 keeps this objective's factors.
         """
-        space = self.candidate.grown
-        given = dict(zip(space.names, map(float, theta0)))
-        th0 = space.vector(given, default={p.name: p.start for p in self.candidate.effect_params})
-        if refresh:
-            fit = self.at(th0).fit(th0, starts=starts, max_nfev=max_nfev, free_joint=free_joint)
-            for _ in range(refresh):
-                again = self.at(fit.theta).fit(fit.theta, starts=1, max_nfev=max_nfev, free_joint=free_joint)
-                fit = replace(again, n_eval=again.n_eval + fit.n_eval)
-            return fit
-        return least_squares_fit(self, th0, given, starts, max_nfev, free_joint)
+        return refreshed_fit(self, theta0, starts, max_nfev, free_joint, refresh)

@@ -39,7 +39,7 @@ from .data import RunEnvelope, run_zeta
 from ..effects import EFFECTS, apply_effect, effects_of
 
 __all__ = ["HELD", "Candidate", "Fit", "Objective", "candidate", "structure_scales", "model_at", "observed",
-           "transient_factor", "least_squares_fit"]
+           "transient_factor", "refreshed_fit", "least_squares_fit"]
 
 HELD = ("beta",)  # joint parameters the envelopes barely constrain: held at the start's value by every fit
 
@@ -247,17 +247,23 @@ class Objective:
         refresh : times the transient factor is retaken (at theta0 first, then at each optimum,
         refitting from it); 0 keeps this objective's factors.
         """
-        c = self.candidate
-        space = c.grown
-        given = dict(zip(space.names, map(float, theta0)))  # the space's leading columns
-        th0 = space.vector(given, default={p.name: p.start for p in c.effect_params})
-        if refresh:
-            fit = self.at(th0).fit(th0, starts=starts, max_nfev=max_nfev, free_joint=free_joint)
-            for _ in range(refresh):
-                again = self.at(fit.theta).fit(fit.theta, starts=1, max_nfev=max_nfev, free_joint=free_joint)
-                fit = replace(again, n_eval=again.n_eval + fit.n_eval)
-            return fit
-        return least_squares_fit(self, th0, given, starts, max_nfev, free_joint)
+        return refreshed_fit(self, theta0, starts, max_nfev, free_joint, refresh)
+
+
+def refreshed_fit(obj, theta0: NDArray, starts: int, max_nfev: int, free_joint: bool, refresh: int) -> Fit:
+    """An objective's fit (`Objective.fit`, `decays.DecayObjective.fit`): theta0 completed with the effects' start
+    values, then `least_squares_fit` at the objective's factors, or, with refresh, at the factors retaken at the
+    start (``obj.at``) and again at each optimum, refitting from it."""
+    space = obj.candidate.grown
+    given = dict(zip(space.names, map(float, theta0)))  # the space's leading columns
+    th0 = space.vector(given, default={p.name: p.start for p in obj.candidate.effect_params})
+    if refresh:
+        fit = obj.at(th0).fit(th0, starts=starts, max_nfev=max_nfev, free_joint=free_joint)
+        for _ in range(refresh):
+            again = obj.at(fit.theta).fit(fit.theta, starts=1, max_nfev=max_nfev, free_joint=free_joint)
+            fit = replace(again, n_eval=again.n_eval + fit.n_eval)
+        return fit
+    return least_squares_fit(obj, th0, given, starts, max_nfev, free_joint)
 
 
 def least_squares_fit(obj: Objective, th0: NDArray, given: Mapping[str, float], starts: int, max_nfev: int,
