@@ -86,9 +86,10 @@ commits, which touch only voltage campaigns: a force run's level is its measured
 0.59 -> 0.58 floor 0.25 (267 s); elastic_softening high 8.87 -> 0.70 floor 0.35 (365 s); cubic_stiffening high
 10.53 -> 0.57 floor 0.24 (148 s).
 
-joint_settling is generated per spec, one spec per sweep rate: the hidden drift restarts at each rate's first run
+joint_settling was generated per spec, one spec per sweep rate: the hidden drift restarted at each rate's first run
 (synth's sequence 1-3 twice), while the campaign here numbers the runs 1-6; the library's settling, monotonic in
-the sequence, cannot follow that on either rig.
+the sequence, could not follow that on either rig. Each rate's spec now continues the sequence (synth's
+``first_sequence``, 2026-11-26): the drift runs on over the six runs as a lab's would.
 """
 import argparse
 import json
@@ -135,7 +136,9 @@ def specs_of(name: str, params: dict, ref: str, seed: int) -> list[dict]:
     effect = {"name": "none", "params": {}} if name == "neighbour_mode" else {
         "name": name, "params": {k: v for k, v in params.items() if k != "also"},
         **({"also": params["also"]} if "also" in params else {})}
-    return [{"seed": 10 * seed + i, "sample_rate_hz": 2048.0, "measurement": {"noise_fraction": 0.02},
+    n = len(levels_V())  # runs per spec: each rate's spec continues the lab's sequence (a settling runs on)
+    return [{"seed": 10 * seed + i, "first_sequence": 1 + n * i, "sample_rate_hz": 2048.0,
+             "measurement": {"noise_fraction": 0.02},
              "sweep": {"f_start_hz": 0.7 * f, "f_stop_hz": 1.3 * f, "rate_hz_per_s": eta * (f * z) ** 2,
                        "ramp_s": 0.05, "tail_s": 1.5},
              "series": [{"level_V": v, "directions": ["up"]} for v in levels_V()],

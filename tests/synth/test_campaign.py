@@ -125,6 +125,23 @@ def test_joint_settling_drifts_the_1g_repeats_monotonically(effect_lab):
 
 
 @pytest.mark.slow
+def test_a_campaign_generated_in_parts_continues_the_settling_along_its_sequence(effect_lab, tmp_path):
+    """A second part (first_sequence 3: a campaign generated one spec per sweep rate) holds runs 3 and 4 of the
+    lab's sequence, and its joint has settled as far as the one-part campaign's runs 3 and 4 (the truth's
+    first-harmonic frequency, the drift X (1 + d (1 - exp(-(n - 1) / n_settle))) at n = 3, 4)."""
+    series = [{"level_g": 1.0, "directions": ["up"], "repeats": 4}]
+    whole = effect_lab("joint_settling", None, series)[2]
+    man, _, part = _campaign(tmp_path, "part", seed=5, sweep=BAND, assemblies={"first": FIRST},
+                             series=[{"level_g": 1.0, "directions": ["up"], "repeats": 2}], first_sequence=3,
+                             effect={"name": "joint_settling", "params": {}})
+    assert list(man["sequence"]) == [3, 4] and all(f"_{n:02d}_1g_up" in r for n, r in zip((3, 4), man.index))
+    np.testing.assert_allclose(part["f_hb_hz"].to_numpy(), whole["f_hb_hz"].to_numpy()[2:], rtol=1e-12)
+    assert part["f_hb_hz"].iloc[0] > whole["f_hb_hz"].iloc[1]  # not restarted at the part's first run
+    with pytest.raises(ValueError, match="first_sequence must be an integer >= 1"):
+        generate({"seed": 5, "first_sequence": 0}, tmp_path / "bad", tmp_path / "bad_truth.json")
+
+
+@pytest.mark.slow
 def test_cubic_stiffening_raises_high_level_resonance(effect_lab):
     base, eff = effect_lab("none"), effect_lab("cubic_stiffening")
     d1 = _res(eff, "1g_up")[0] / _res(base, "1g_up")[0] - 1

@@ -48,7 +48,7 @@ def plan_runs(spec: dict) -> pd.DataFrame:
     key = RIG_LEVEL[ref]
     unit = key.split("_")[1]
     for assembly in spec["assemblies"]:
-        seq = 0
+        seq = int(spec.get("first_sequence", 1)) - 1  # a campaign generated in parts continues its sequence
         for item in spec["series"]:
             if item.get("test", "sweep") != "sweep":  # dwells or ring-downs: one run per drive frequency
                 if item["test"] not in PLANS:

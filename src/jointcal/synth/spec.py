@@ -3,6 +3,9 @@
 Keys (units lbf, in, s, g):
 
 seed                 int, required: every random draw follows from it.
+first_sequence       int >= 1, optional (default 1): the place of the spec's first run in the
+                     lab's run sequence, for a campaign generated in parts (one spec per sweep
+                     rate): a drift along the sequence (joint_settling) runs on across them.
 sample_rate_hz       output sample rate of the files.
 file_format          csv | csv.gz | mat.
 slug_weight_lbf      slug weight (mass = weight / 386.089).
@@ -169,11 +172,16 @@ def _check_shapes(s: dict, where: str) -> None:
 def load_spec(spec: dict | str | os.PathLike) -> dict:
     """Complete a spec with the defaults and validate it (one clear error per problem)."""
     spec, where, root = _read_spec(spec)
-    unknown = set(spec) - set(DEFAULT_SPEC) - {"seed", "effect_file"}
+    unknown = set(spec) - set(DEFAULT_SPEC) - {"seed", "effect_file", "first_sequence"}
     if unknown:
-        raise ValueError(f"{where}: unknown key(s) {sorted(unknown)}; valid keys are {sorted(DEFAULT_SPEC)} + seed.")
+        raise ValueError(f"{where}: unknown key(s) {sorted(unknown)}; valid keys are {sorted(DEFAULT_SPEC)} + seed, "
+                         "first_sequence.")
     if "seed" not in spec or not isinstance(spec["seed"], int):
         raise ValueError(f"{where}: 'seed' must be given as an integer so the campaign is reproducible.")
+    first = spec.get("first_sequence", 1)
+    if isinstance(first, bool) or not isinstance(first, int) or first < 1:
+        raise ValueError(f"{where}: first_sequence must be an integer >= 1 (the spec's first run's place in the "
+                         f"lab's sequence), got {first!r}.")
     s = _merge(DEFAULT_SPEC, spec)
     if "effect_file" in s:
         ef = root / s.pop("effect_file")
