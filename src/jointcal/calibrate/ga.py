@@ -125,8 +125,18 @@ def _mutate(ind: list, sigma: list[float], indpb: float) -> tuple[list]:
     return (ind,)
 
 
+def _clone(ind: list) -> list:
+    """The copy `copy.deepcopy` makes of an individual (its genes, floats, shared as deepcopy shares them; a new
+    fitness holding the same weighted values, as `deap.base.Fitness.__deepcopy__` makes it), without deepcopy's
+    walk over each gene: the toolbox's default clone took a third of a generation's Python time."""
+    new = creator.JointcalIndividual(ind)
+    new.fitness.wvalues = ind.fitness.wvalues
+    return new
+
+
 def _toolbox(opt: GAOptions) -> base.Toolbox:
     tb = base.Toolbox()
+    tb.register("clone", _clone)
     tb.register("mate", tools.cxSimulatedBinaryBounded, eta=opt.sbx_eta, low=0.0, up=1.0)
     tb.register("select", tools.selTournament, tournsize=opt.tournament)
     return tb
