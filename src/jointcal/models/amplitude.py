@@ -191,6 +191,9 @@ def _curves(q, Fs, KT, chi, beta, k, m, zeta_v, *, harmonic: bool, viscous: Visc
     """
     q = np.asarray(q, dtype=float)
     params = [np.asarray(a, dtype=float) for a in (Fs, KT, chi, beta, k, zeta_v, m)]  # the kernel's columns
+    if q.ndim == 0 and all(p.ndim == 0 for p in params):  # one point (the rig truths' bisections): one row
+        f, zeta = _run(q.reshape(1, 1), np.array([params]), harmonic, viscous)
+        return f[0, 0], zeta[0, 0]
     shape = np.broadcast_shapes(q.shape, *(p.shape for p in params))
     full = shape or (1,)
     if all(p.ndim == 0 or p.shape[-1] == 1 for p in params):  # one parameter set per row
