@@ -45,9 +45,11 @@ class Calibration:
     curves: pd.DataFrame
 
 
-def _residuals(theta: NDArray[np.float64], data: ModalData, s: CalibrateSettings) -> NDArray[np.float64]:
-    """Residual vectors whose squared norms are eq. 3.9, shape (P, 2N), for parameters theta (P, n) of `s.space`."""
-    f_m, z_m = predict(s.space.joint(np.atleast_2d(theta)), data.q, m=s.m, model=s.model, viscous=s.viscous)
+def _residuals(theta: NDArray[np.float64], data: ModalData, s: CalibrateSettings,
+               space: ParamSpace) -> NDArray[np.float64]:
+    """Residual vectors whose squared norms are eq. 3.9, shape (P, 2N), for parameters theta (P, n) of `space`
+    (`s.space`, built once by the caller: the property makes a new, validated space at each access)."""
+    f_m, z_m = predict(space.joint(np.atleast_2d(theta)), data.q, m=s.m, model=s.model, viscous=s.viscous)
     n = data.q.size
     if data.weight is not None:  # read-outs of many points: each residual times the square root of its weight
         w, n = data.w, data.n_readouts
@@ -59,7 +61,8 @@ def _residuals(theta: NDArray[np.float64], data: ModalData, s: CalibrateSettings
 
 def polish(u0: NDArray[np.float64], data: ModalData, s: CalibrateSettings) -> NDArray[np.float64]:
     """Refine a unit-cube point by bounded least squares on the eq. 3.9 residuals (`least_squares_polish`)."""
-    return least_squares_polish(u0, lambda U: _residuals(s.space.to_physical(U), data, s))
+    space = s.space  # once, not at each of the least squares' evaluations
+    return least_squares_polish(u0, lambda U: _residuals(space.to_physical(U), data, s, space))
 
 
 def least_squares_polish(u0: NDArray[np.float64],
@@ -226,7 +229,7 @@ def calibrate(data: ModalData, s: CalibrateSettings, *, resume: dict[str, Any] |
     value = float(batch(u_best[None])[0])
     n = data.q.size
     if data.weight is None:  # one point per run
-        r = _residuals(theta, data, s)[0]
+        r = _residuals(theta, data, s, space)[0]
         rms = [float(np.sqrt(np.mean((r[:n] / np.sqrt(s.eta / n)) ** 2))) if s.eta > 0 else None,
                float(np.sqrt(np.mean((r[n:] / np.sqrt((1 - s.eta) / n)) ** 2))) if s.eta < 1 else None]
     else:  # the weighted rms over read-outs
