@@ -135,6 +135,15 @@ def write_json_atomic(obj: Any, path: str | os.PathLike[str], *, indent: int = 2
     return _write_atomic(path, _text(dump))
 
 
+def _csv_bytes(cols: dict[str, np.ndarray]) -> bytes:
+    """The columns as CSV: a header of their names, then one ``%.9g`` line per sample. The bytes
+    ``np.savetxt(fmt="%.9g", delimiter=",", header=..., comments="")`` writes, formatted from Python floats in
+    one pass (savetxt formats and writes line by line: two fifths of a record's text time)."""
+    line = ",".join(["%.9g"] * len(cols)) + "\n"
+    rows = np.column_stack(list(cols.values())).tolist()
+    return (",".join(cols) + "\n" + "".join([line % tuple(r) for r in rows])).encode("latin1")
+
+
 def write_run(path: str | os.PathLike[str], time_s: ArrayLike, base_or_force: ArrayLike, response_g: ArrayLike,
               *, kind: Excitation = "base") -> Path:
     """Write one run record in the raw-data contract (``.csv``, ``.csv.gz`` or ``.mat``).
@@ -174,10 +183,7 @@ def write_run(path: str | os.PathLike[str], time_s: ArrayLike, base_or_force: Ar
         data = buf.getvalue()
         data = b"MATLAB 5.0 MAT-file, written by jointcal".ljust(116) + data[116:]
     elif name.endswith((".csv", ".csv.gz")):
-        buf = io.BytesIO()
-        np.savetxt(buf, np.column_stack(list(cols.values())), fmt="%.9g", delimiter=",",
-                   header=",".join(cols), comments="")
-        data = buf.getvalue()
+        data = _csv_bytes(cols)
         if name.endswith(".gz"):
             data = gzip.compress(data, compresslevel=6, mtime=0)
     else:
