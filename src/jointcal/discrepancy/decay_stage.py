@@ -131,6 +131,11 @@ def linearisation_error(lin: DecayObjective, exact: DecayObjective, theta: np.nd
     return replace(lin, runs=tuple(pseudo)).E(theta)
 
 
+def _model_words(name: str) -> str:
+    """'the baseline' or 'the cubic stiffening model' (a pair: 'the elastic softening + cubic stiffening model')."""
+    return "the baseline" if name == "baseline" else f"the {name.replace('_', ' ').replace('+', ' + ')} model"
+
+
 def fold_floor(lin: DecayObjective, folds: Mapping[str, Sequence[int]], max_nfev: int) -> dict:
     """The fast model's own error where the held-out scores are taken: on each fold, a candidate's objective
     linearised at its full fit (`lin`, as `select` scores it) refit without the fold, against the time simulation's read-out of
@@ -144,7 +149,7 @@ def fold_floor(lin: DecayObjective, folds: Mapping[str, Sequence[int]], max_nfev
         per[name] = linearisation_error(held, held.at(th), th)
     E = float(np.sqrt(np.mean(np.square(list(per.values()))))) if per else 0.0
     return {"E": E, "per_fold": per,
-            "what": (f"the fast model of {lin.candidate.name.replace('_', ' ')}, its read-out factor taken at its fit "
+            "what": (f"the fast model of {_model_words(lin.candidate.name)}, its read-out factor taken at its fit "
                      "on all runs, against the time simulation's read-out at each held-out fold's refit, on that fold")}
 
 
