@@ -12,6 +12,7 @@ from scipy import signal
 from jointcal.io import CampaignError, CampaignWarning, ingest_campaign, read_manifest, read_run, validate_run
 from jointcal.io._clipping import clip_levels, clipped_mask
 from tests._support.campaign import REPO
+from tests._support.lti import lsim
 from tests._support.ingest import _one_sentence
 
 
@@ -46,7 +47,7 @@ def test_clipped_mask_marks_exactly_the_clipped_samples():
 
 def _sdof_sweep(fs: float, *, level: float = 1.0, fn: float = 2200.0, zeta: float = 0.02, rate: float = 2000.0,
                 band: tuple[float, float] = (1800.0, 2600.0), seed: int = 7):
-    """A linear SDOF base-excited sweep (exact for piecewise-linear input, scipy.signal.lsim).
+    """A linear SDOF base-excited sweep (exact for piecewise-linear input: scipy.signal.lsim's recursion, tests._support.lti).
 
     Returns time (s), base (g), absolute response (g) with 0.3 % noise, and the response's
     peak at resonance (g). Units g, s, Hz.
@@ -59,7 +60,7 @@ def _sdof_sweep(fs: float, *, level: float = 1.0, fn: float = 2200.0, zeta: floa
     base = level * np.sin(2 * np.pi * (f0 * tt + 0.5 * rate * tt**2)) * (t < sweep_s)
     w = 2 * np.pi * fn
     sdof = signal.StateSpace([[0.0, 1.0], [-w * w, -2 * zeta * w]], [[0.0], [-1.0]], [[-w * w, -2 * zeta * w]], [[0.0]])
-    _, resp, _ = signal.lsim(sdof, base, t)
+    resp = lsim(sdof, base, t)
     base = base + 0.003 * level * rng.standard_normal(t.size)
     resp = resp + 0.003 * np.std(resp) * rng.standard_normal(t.size)
     return t, base, resp, float(np.abs(resp).max())

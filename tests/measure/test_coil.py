@@ -6,7 +6,6 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from scipy import signal
 
 from jointcal.measure._coil import coil_pole
 from jointcal.measure._rotating import demodulate, passage
@@ -14,6 +13,7 @@ from jointcal.measure._sweep_problem import NP, Problem
 from jointcal.measure.sweepfit import fit_swept_mode
 from jointcal.units import G
 from tests._support.jacobian import assert_matches_central_difference
+from tests._support.lti import lsim
 
 
 def _cardano(a: float, b: float, c: float) -> np.ndarray:
@@ -41,7 +41,7 @@ def test_the_pole_is_the_closed_form_root_of_the_coupled_cubic(w_e_over, g_over,
 
 def _voltage_chirp(f0, zeta, w_e, g, f_lo, f_hi, rate, fs, tail, over=32):
     """A linear mode driven through a coil by a unit voltage chirp, integrated apart (scipy's lsim of the
-    real 3-state system, `over` times oversampled): (V, response acceleration in g) at fs."""
+    real 3-state system, `tests._support.lti.lsim`, `over` times oversampled): (V, response acceleration in g) at fs."""
     om = 2 * np.pi * f0
     A = np.array([[0.0, 1.0, 0.0], [-om**2, -2 * zeta * om, 1.0], [0.0, -g, -w_e]])
     B = np.array([[0.0], [0.0], [w_e]])
@@ -50,7 +50,7 @@ def _voltage_chirp(f0, zeta, w_e, g, f_lo, f_hi, rate, fs, tail, over=32):
     t = np.arange(int((dur + tail) * fs * over)) / (fs * over)
     ph = 2 * np.pi * (f_lo * t + 0.5 * rate * t**2)
     v = np.where(t <= dur, np.sin(ph), 0.0) * np.clip(t / 0.05, 0, 1)
-    _, y, _ = signal.lsim((A, B, Cm, np.zeros((1, 1))), v, t, interp=True)
+    y = lsim((A, B, Cm, np.zeros((1, 1))), v, t)
     return v[::over], y[::over] / G
 
 
