@@ -63,10 +63,24 @@ def _module_name(f: Path) -> tuple[str, bool] | None:
     return ".".join(parts), False
 
 
-def _imported(tree: ast.AST, here: tuple[str, bool] | None) -> set[str]:
+def _statements(body: list[ast.stmt]):
+    """Every statement of a block and of the blocks nested in it (function and class bodies, branches, loops,
+    ``try`` handlers, ``with`` and ``match`` blocks): where an import statement can stand, without walking the
+    expressions, which hold none."""
+    for node in body:
+        yield node
+        for field in ("body", "orelse", "finalbody"):
+            sub = getattr(node, field, None)
+            if isinstance(sub, list):
+                yield from _statements(sub)
+        for part in (*getattr(node, "handlers", ()), *getattr(node, "cases", ())):
+            yield from _statements(part.body)
+
+
+def _imported(tree: ast.Module, here: tuple[str, bool] | None) -> set[str]:
     """Dotted names a module's import statements may load (a ``from`` import's names may be modules)."""
     names: set[str] = set()
-    for node in ast.walk(tree):
+    for node in _statements(tree.body):
         if isinstance(node, ast.Import):
             names.update(a.name for a in node.names)
         elif isinstance(node, ast.ImportFrom):
