@@ -30,7 +30,7 @@ import numpy as np
 import pandas as pd
 
 from ..io.contract import LEVEL, REFERENCE, RESPONSE, UNUSABLE
-from ..io._kinds import DWELL
+from ..io.testkinds import DWELL
 from ..spectral import peak_frequency
 from ..units import G
 from .dwell import dwell_mode, dwell_point

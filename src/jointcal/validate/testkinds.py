@@ -20,7 +20,7 @@ import numpy as np
 import pandas as pd
 
 from ..io.contract import excitation_kind
-from ..io._kinds import DWELL, kind_of
+from ..io.testkinds import DWELL, test_kind
 from ..measure.dwell import dwell_point
 from ..measure.testkinds import RECEPTANCE_COLUMNS, read_test_run, row_receptance
 from ..models import MinistackModel
@@ -100,7 +100,7 @@ def validate_test_run(model: MinistackModel, record: pd.DataFrame, row: Mapping,
     """
     t0 = time.perf_counter()
     row = dict(row)
-    head = {**run_head(row), "test": kind_of(row)}
+    head = {**run_head(row), "test": test_kind(row)}
     fs = float(row["sample_rate_hz"])
     kind = excitation_kind(record.columns)
     read = measured_read(record, row) if read is None else read
