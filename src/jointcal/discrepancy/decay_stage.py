@@ -38,7 +38,7 @@ import pandas as pd
 from ..calibrate.space import PARAMS, ParamSpace
 from ..effects import EFFECTS, effects_of
 from ..io import excitation_kind, level_column, test_kind
-from ..measure.testkinds import read_test_run
+from ..measure.testkinds.read import read_test_run
 from ..validate import ValidateSettings, model_from_best, validate_runs
 from .decays import DecayObjective, DecayRun, decay_folds, decay_runs
 from .fit import candidate, model_at

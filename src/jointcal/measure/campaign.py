@@ -42,7 +42,7 @@ from .frf import displacement_ratio, h1_estimate
 from .modal import modal_properties
 from .modes import mode_name, modal_peaks, track_modes
 from .receptance import Receptance, flank_receptance
-from .testkinds import other_kinds_modal
+from .testkinds.read import other_kinds_modal
 
 __all__ = ["campaign_modal", "run_peaks", "assembly_coil"]
 

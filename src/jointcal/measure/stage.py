@@ -24,7 +24,7 @@ from .campaign import campaign_modal
 from .flags import run_flags
 from .frf import frf_table
 from .scatter import scatter
-from .testkinds import backbone_table
+from .testkinds.read import backbone_table
 
 __all__ = ["run_modal", "run_modal_unit"]
 

@@ -22,7 +22,7 @@ import pandas as pd
 from ..io.contract import excitation_kind
 from ..io.testkinds import DWELL, test_kind
 from ..measure.dwell import dwell_point
-from ..measure.testkinds import RECEPTANCE_COLUMNS, read_test_run, row_receptance
+from ..measure.testkinds.read import RECEPTANCE_COLUMNS, read_test_run, row_receptance
 from ..models import MinistackModel
 from .decay import compare_decay, decay_from_cut, decay_input
 from .drive import model_input, reference_column, response_to
