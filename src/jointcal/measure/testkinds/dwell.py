@@ -30,7 +30,8 @@ STEADY = Estimator(
     "dwell",
     "its steady point (dwell): the response over the reference at dwell_hz, with the modal constant of its "
     "level's three or more dwells (force-referenced: the one the mode's sweep measured) giving its natural "
-    "frequency and damping at the amplitude it reached, not read without one (few_dwells)",
+    "frequency and damping at the amplitude it reached (and the level's phase resonance), not read without one "
+    "(few_dwells)",
     _steady_point, level_readout=LEVEL_READOUT)
 
 RULE = ReadoutRule("dwell", (STEADY, optional(WINDOWS, f"the record goes on for {MIN_DECAY_S:g} s or more after "

@@ -19,8 +19,8 @@ def _top_window(read) -> Readout | Refusal:
 
 WINDOWS = Estimator(
     METHOD,
-    "the largest-amplitude window of its free decay (ringdown): damped-sinusoid fits in sliding windows down to "
-    "the noise floor, read through the force with the modal constant the mode's sweep measured where a force "
+    "the largest-amplitude window of its free decay (ringdown): damped-sinusoid fits in sliding windows that "
+    "lengthen as the decay nears the noise, one point per window down to the noise floor, read through the force with the modal constant the mode's sweep measured where a force "
     f"reference stays live after the cut (through_force), not read without a decay of {MIN_DECAY_S:g} s or more "
     "(no_decay) or where the shaker stays on and no sweep measured the mode (shaker_on)",
     _top_window)
