@@ -81,7 +81,7 @@ def not_seen(names: Sequence[str], space: ParamSpace, m: float, scales, runs: Se
 
 def read_again(records: Sequence[pd.DataFrame], rows: Sequence[Mapping]) -> dict[str, pd.DataFrame]:
     """Each ring-down's windows read from its record as the modal stage and the validation read them
-    (`jointcal.measure.testkinds.read_test_run`), for the read-out's own standard errors; run_id -> windows."""
+    (`jointcal.measure.testkinds.read.read_test_run`), for the read-out's own standard errors; run_id -> windows."""
     out = {}
     for rec, row in zip(records, rows):
         if run_test_kind(row).swept:

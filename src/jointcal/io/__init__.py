@@ -14,6 +14,10 @@ Modules, in the order a record flows through them:
 
 * `contract` (public): the contract's names, units and errors; `excitation_kind`, the one rule
   that tells a run's excitation from its columns or its level column.
+* `testkinds` (public): the test kinds (the manifest's ``test``: ``sweep``, ``dwell``,
+  ``ringdown``), one module each in a registry like `jointcal.effects`: a kind's manifest
+  columns, its row's checks, the band its drive is checked over, whether its reference may be
+  absent; `run_test_kind(row)` is what the stages ask instead of comparing names.
 * `_manifest`: ``manifest.csv``, every row checked (`read_manifest`).
 * `_records`: one record, the contract's CSV or MAT (`read_run`), a whole campaign
   (`ingest_campaign`), a manifest file among a rule's inputs (`listed_record`).

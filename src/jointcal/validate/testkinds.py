@@ -1,6 +1,6 @@
 """A dwell or ring-down run validated as it was done (the sweeps': `jointcal.validate.runs`).
 
-The run is read as the modal stage read it (`jointcal.measure.testkinds.read_test_run`: the same frequency,
+The run is read as the modal stage read it (`jointcal.measure.testkinds.read.read_test_run`: the same frequency,
 decay start, ring-down windows and dwell point), then:
 
 * a dwell's steady point: the model driven by the dwell's record, read by the same lock-in
@@ -64,7 +64,7 @@ def _mode_hz(row: Mapping) -> float | None:
 
 
 def measured_read(record: pd.DataFrame, row: Mapping) -> dict:
-    """The run's record read as the modal stage read it (`jointcal.measure.testkinds.read_test_run` at the row's
+    """The run's record read as the modal stage read it (`jointcal.measure.testkinds.read.read_test_run` at the row's
     ``mode_hz``, through the force as measured): its dwell point, decay windows, start and flags. It does not depend
     on the model: a caller that validates many models against one record reads it once."""
     return read_test_run(row, record, excitation_kind(record.columns), _mode_hz(row), row_receptance(row))
