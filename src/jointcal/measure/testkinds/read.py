@@ -20,7 +20,6 @@ The runs of the other test kinds (`jointcal.io.testkinds`), in the order data fl
    where the mode's sweep measured its modal constant and the other modes' receptance R
    (`jointcal.measure.receptance`), each dwell's X - R is read with that constant, however few dwells
    a level holds: an open-loop rig's manifest level is the force each dwell measured, one per dwell.
-
 4. **The run's row**: its kind's read-out rule (`jointcal.measure.testkinds.registry.READOUT_RULES`),
    the first of its estimators that reads it (a ring-down's largest-amplitude window, a dwell's point),
    ``f_res_method`` naming it, so the later stages read it like a sweep's; ``unusable`` where all refuse.
