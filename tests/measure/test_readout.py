@@ -6,7 +6,7 @@ from pathlib import Path
 
 from jointcal.io.testkinds import TEST_KINDS
 from jointcal.measure.testkinds import (READOUT_RULES, Estimator, Readout, ReadoutRule, Refusal, estimator_of,
-                                        methods, optional, rule_text)
+                                        level_readout, methods, optional, rule_text)
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -20,6 +20,7 @@ def test_every_kind_not_read_as_a_sweep_has_a_read_out_rule():
     assert set(READOUT_RULES) == {n for n, k in TEST_KINDS.items() if not k.swept}
     assert methods() == ("dwell", "ringdown") and estimator_of("sweep_fit") is None
     assert estimator_of("dwell").level_readout == ("q_dwell_quad_in", "f_dwell_quad_hz", "zeta_dwell_quad")
+    assert level_readout("dwell") == estimator_of("dwell").level_readout and level_readout("ringdown") is None
 
 
 def _est(method, out):

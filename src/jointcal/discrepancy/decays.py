@@ -41,7 +41,8 @@ from numpy.typing import NDArray
 
 from ..io import level_column
 from ..io.contract import UNUSABLE
-from ..measure.testkinds import estimator_of
+from ..io.testkinds import run_test_kind
+from ..measure.testkinds import level_readout
 from ..measure.testkinds.ringdown import METHOD as WINDOWS
 from ..models.free_decay import free_backbone
 from ..validate.decay import scales
@@ -121,8 +122,8 @@ def _points(backbone: pd.DataFrame, modal: pd.DataFrame, rows: Sequence[Mapping]
         if len(w):
             out.append((r, w.sort_values("q_in", ascending=False).reset_index(drop=True)))
         col = level_column(r)
-        est = estimator_of(r.get("f_res_method"))  # a dwell's: its level's phase resonance, one read-out
-        quad = [float(pd.to_numeric(r.get(c), errors="coerce")) for c in (est.level_readout or ())] if est else []
+        cols = level_readout(run_test_kind(r).name) or ()  # a dwell's: its level's phase resonance, one read-out
+        quad = [float(pd.to_numeric(r.get(c), errors="coerce")) for c in cols]
         if quad and all(np.isfinite(quad)) and min(quad) > 0:
             key = (col, r.get(col))
             if key not in levels_done:  # a level's phase resonance, once for its dwells

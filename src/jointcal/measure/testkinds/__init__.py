@@ -28,7 +28,7 @@ import it and ``register`` it below; quote `rule_text` in raw_data/README.md's *
 """
 from . import dwell, ringdown
 from .readout import Estimator, Readout, ReadoutRule, Refusal, optional
-from .registry import READOUT_RULES, estimator_of, methods, register
+from .registry import READOUT_RULES, estimator_of, level_readout, methods, register
 
 for _module in (dwell, ringdown):
     register(_module.RULE)
@@ -39,5 +39,5 @@ def rule_text() -> str:
     return " ".join(r.text for r in READOUT_RULES.values())
 
 
-__all__ = ["READOUT_RULES", "register", "methods", "estimator_of", "rule_text", "Estimator", "Readout", "Refusal",
+__all__ = ["READOUT_RULES", "register", "methods", "estimator_of", "level_readout", "rule_text", "Estimator", "Readout", "Refusal",
            "ReadoutRule", "optional"]
