@@ -75,7 +75,7 @@ def modal_tables(folder: Path) -> Path:
     from jointcal.measure.campaign import campaign_modal
     from jointcal.measure.envelopes import envelopes, meta_dict
     from jointcal.measure.scatter import scatter
-    from jointcal.measure.testkinds import backbone_table
+    from jointcal.measure.testkinds.read import backbone_table
 
     runs = ingest_campaign(folder / "campaign")
 

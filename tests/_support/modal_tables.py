@@ -78,7 +78,7 @@ def write_tables(folder, truths, **kw):
     from pathlib import Path
 
     from jointcal.measure.modes import with_modes
-    from jointcal.measure.testkinds import backbone_table
+    from jointcal.measure.testkinds.read import backbone_table
 
     modal, scatter = modal_tables(truths, **kw)
     d = Path(folder) / "modal"

@@ -55,7 +55,7 @@ def backbone_here(out: Path) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The dwell campaign's backbone points and modal table, read with the modal stage's functions (no workflow)."""
     from jointcal.io import ingest_campaign, read_run
     from jointcal.measure.campaign import campaign_modal
-    from jointcal.measure.testkinds import backbone_table
+    from jointcal.measure.testkinds.read import backbone_table
 
     runs = ingest_campaign(out)
     points: list = []

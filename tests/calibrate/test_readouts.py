@@ -12,7 +12,7 @@ import pytest
 
 from jointcal.calibrate import CalibrateSettings, objective, read_modal, run_calibration, select_modal
 from jointcal.io import write_csv_atomic
-from jointcal.measure.testkinds import backbone_table
+from jointcal.measure.testkinds.read import backbone_table
 from jointcal.models import harmonic_balance, resonance_amplitude
 from jointcal.posterior import PosteriorSettings, run_posterior
 from jointcal.posterior.identified import identified_table, quantities

@@ -1,4 +1,4 @@
-"""The manifest's test kinds (jointcal.io._kinds): sweep by default, dwell and ringdown, and their checks."""
+"""The manifest's test kinds (jointcal.io.testkinds): sweep by default, dwell and ringdown, and their checks."""
 from __future__ import annotations
 
 import numpy as np

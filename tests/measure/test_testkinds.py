@@ -9,7 +9,7 @@ import pytest
 from jointcal.io import ingest_campaign, read_run
 from jointcal.measure.campaign import campaign_modal
 from jointcal.measure.scatter import scatter
-from jointcal.measure.testkinds import BACKBONE_COLUMNS, backbone_table
+from jointcal.measure.testkinds.read import BACKBONE_COLUMNS, backbone_table
 from tests._support.kinds_records import FN, ZETA, dwell_row, kinds_campaign, linear_dwell
 
 FREQS = (19.3, 19.9, 20.2, 20.5, 21.1)
@@ -78,7 +78,7 @@ def test_a_decay_with_the_shaker_left_on_is_not_read_as_the_structures_backbone(
     # goes on reading the armature's reaction: the decay rings at the coupled rig's pole, 2.4% below the structure's
     # (tests/benchmarks/accept_testkinds.py), so it is flagged and not read; the dwell's own point stands. With a
     # voltage reference the rig's pole is what the whole campaign reads: the decay is read.
-    from jointcal.measure.testkinds import read_test_run
+    from jointcal.measure.testkinds.read import read_test_run
     from jointcal.synth import generate
     from tests._support import rigs
 

@@ -9,7 +9,7 @@ import pytest
 
 from jointcal.io import ingest_campaign, read_run
 from jointcal.measure.campaign import campaign_modal
-from jointcal.measure.testkinds import backbone_table
+from jointcal.measure.testkinds.read import backbone_table
 from jointcal.models import harmonic_balance
 from jointcal.synth import DEFAULT_SPEC, generate
 from jointcal.units import G

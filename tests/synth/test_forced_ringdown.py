@@ -13,7 +13,7 @@ import pandas as pd
 import pytest
 
 from jointcal.io import ingest_campaign, read_run
-from jointcal.measure.testkinds import RECEPTANCE_COLUMNS
+from jointcal.measure.testkinds.read import RECEPTANCE_COLUMNS
 from jointcal.models import IwanParams
 from jointcal.validate.drive import drive_gain
 from jointcal.validate.testkinds import as_read, validate_test_run

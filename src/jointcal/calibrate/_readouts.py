@@ -5,11 +5,13 @@ ring-down's largest window, a dwell's own point. ``backbone.csv`` holds every am
 point (`jointcal.measure.testkinds`). With it, `expand` turns one unit's usable rows into the
 points eq. 3.9 and the likelihood sum over, in the order data flows:
 
-1. **Sweeps** (``f_res_method`` neither ``ringdown`` nor ``dwell``): the row, as without it.
-2. **Ring-downs** (``f_res_method`` ``ringdown``, and the ring-down a dwell record holds after its
-   cut): every window of the run in backbone.csv (``test`` ``ringdown``).
-3. **Dwells** (``f_res_method`` ``dwell``): each level's phase resonance (``q_dwell_quad_in``,
-   ``f_dwell_quad_hz``, ``zeta_dwell_quad``), once for the level's dwells. A dwell's own point
+1. **Sweeps** (``f_res_method`` no test kind's estimator writes, `jointcal.measure.testkinds.estimator_of`):
+   the row, as without it.
+2. **Ring-downs** (any test kind's read-out: ``ringdown``, and the ring-down a dwell record holds after
+   its cut): every window of the run in backbone.csv (``test`` ``ringdown``); a run without windows whose
+   estimator reads each run on its own, its row.
+3. **Dwells** (an estimator with a ``level_readout``: ``dwell``): each level's phase resonance
+   (``q_dwell_quad_in``, ``f_dwell_quad_hz``, ``zeta_dwell_quad``), once for the level's dwells. A dwell's own point
    has its natural frequency exactly but its damping only at phase resonance (docs/physics.md
    section 8: 6% high 3% below resonance on the virtual Ministack, 30% low off resonance on the
    real beam), so the points of a level's dwells do not enter, their phase resonance does; a
@@ -29,9 +31,13 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from ..measure.testkinds import estimator_of
+from ..measure.testkinds.dwell import STEADY
+from ..measure.testkinds.ringdown import METHOD as WINDOWS
+
 __all__ = ["expand", "QUAD"]
 
-QUAD = ("q_dwell_quad_in", "f_dwell_quad_hz", "zeta_dwell_quad")  # a level's phase resonance (modal table)
+QUAD = STEADY.level_readout  # a level's dwells' phase resonance (modal table): q, f, zeta
 _VALUES = ("q_in", "f_hz", "zeta")
 
 
@@ -45,7 +51,7 @@ def _positive(table: pd.DataFrame, cols) -> np.ndarray:
 
 def _windows(backbone: pd.DataFrame, run_id: str, mode) -> pd.DataFrame:
     """The run's ring-down windows in backbone.csv with positive q, f and zeta (its mode's, when named)."""
-    w = backbone[(backbone["run_id"].astype(str) == run_id) & (backbone["test"] == "ringdown")]
+    w = backbone[(backbone["run_id"].astype(str) == run_id) & (backbone["test"] == WINDOWS)]
     if mode is not None and "mode" in w and pd.notna(mode):
         w = w[w["mode"].astype(str) == str(mode)]
     return w[_positive(w, _VALUES)]
@@ -92,17 +98,18 @@ def expand(rows: pd.DataFrame, backbone: pd.DataFrame, level: np.ndarray, column
     dwell_levels: dict[tuple, list[int]] = {}
     for i, (_, r) in enumerate(rows.iterrows()):
         rid = str(r["run_id"])
-        if method.iloc[i] == "dwell":
-            key = tuple(float(r[c]) if c in r and pd.notna(r[c]) else np.nan for c in QUAD)
+        est = estimator_of(method.iloc[i])  # a test kind's read-out (`jointcal.measure.testkinds`), None: a sweep's
+        if est is not None and est.level_readout is not None:  # a level's runs hold one read-out together
+            key = tuple(float(r[c]) if c in r and pd.notna(r[c]) else np.nan for c in est.level_readout)
             dwell_levels.setdefault((float(level[i]) if np.isfinite(level[i]) else np.nan, *key), []).append(i)
-        if method.iloc[i] in ("ringdown", "dwell"):
+        if est is not None:
             w = _windows(backbone, rid, r.get("mode"))
             if len(w):
                 add(rid, level[i], w[_VALUES[0]], w[_VALUES[1]], w[_VALUES[2]], 1.0 / len(w))
                 notes.append(f"{where}: run {rid!r}: its ring-down's {len(w)} windows over "
                              f"{np.log10(w['q_in'].max() / w['q_in'].min()):.2f} decades of amplitude, one read-out "
                              f"(weight 1/{len(w)} each)")
-            elif method.iloc[i] == "ringdown":  # no windows in the table: the run's row, as without it
+            elif est.level_readout is None:  # no windows in the table: the run's row, as without it
                 add(rid, level[i], r[qc], r[fc], r[zc], 1.0)
                 notes.append(f"{where}: run {rid!r} has no ring-down windows; its modal row is its read-out")
         else:

@@ -29,6 +29,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from ..models.free_decay import free_backbone
+from ..validate.decay import PART as DECAY
 from ..validate.testkinds import validate_test_run
 from .fit import Candidate, model_at
 
@@ -51,7 +52,7 @@ def simulated_readout(c: Candidate, theta: NDArray, record: pd.DataFrame | None,
     frames, _ = validate_test_run(model_at(c, np.asarray(theta, dtype=float), row), record, row, read=read)
     if frames.empty or "part" not in frames:
         return None
-    fr = frames[(frames["part"] == "ringdown") & frames["in_range"].astype(bool)]
+    fr = frames[(frames["part"] == DECAY) & frames["in_range"].astype(bool)]
     q, f, z = (fr[k].to_numpy(float) for k in ("q_meas_in", "f_sim_hz", "zeta_sim"))
     ok = np.isfinite(q) & np.isfinite(f) & np.isfinite(z) & (q > 0) & (f > 0) & (z > 0)
     return fr[ok] if ok.any() else None

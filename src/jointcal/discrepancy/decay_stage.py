@@ -37,9 +37,10 @@ import pandas as pd
 
 from ..calibrate.space import PARAMS, ParamSpace
 from ..effects import EFFECTS, effects_of
-from ..io import excitation_kind, level_column, test_kind
-from ..measure.testkinds import read_test_run
+from ..io import excitation_kind, level_column, run_test_kind
+from ..measure.testkinds.read import read_test_run
 from ..validate import ValidateSettings, model_from_best, validate_runs
+from ..validate.decay import PART as DECAY
 from .decays import DecayObjective, DecayRun, decay_folds, decay_runs
 from .fit import candidate, model_at
 from .recalibrate import recalibrate
@@ -80,10 +81,10 @@ def not_seen(names: Sequence[str], space: ParamSpace, m: float, scales, runs: Se
 
 def read_again(records: Sequence[pd.DataFrame], rows: Sequence[Mapping]) -> dict[str, pd.DataFrame]:
     """Each ring-down's windows read from its record as the modal stage and the validation read them
-    (`jointcal.measure.testkinds.read_test_run`), for the read-out's own standard errors; run_id -> windows."""
+    (`jointcal.measure.testkinds.read.read_test_run`), for the read-out's own standard errors; run_id -> windows."""
     out = {}
     for rec, row in zip(records, rows):
-        if test_kind(row) == "sweep":
+        if run_test_kind(row).swept:
             continue
         try:
             w = read_test_run(dict(row), rec, excitation_kind(rec.columns), row.get("mode_hz"))["windows"]
@@ -103,9 +104,9 @@ def decay_floor(c, theta: np.ndarray, runs: Sequence[DecayRun], frames: Mapping[
     pseudo, per = [], {}
     for rid in dict.fromkeys(r.run_id for r in runs):
         fr = frames.get(rid)
-        if fr is None or "part" not in fr or not (fr["part"] == "ringdown").any():
+        if fr is None or "part" not in fr or not (fr["part"] == DECAY).any():
             continue
-        fr = fr[(fr["part"] == "ringdown") & fr["in_range"].astype(bool)]
+        fr = fr[(fr["part"] == DECAY) & fr["in_range"].astype(bool)]
         own = [r for r in runs if r.run_id == rid]
         sf = float(np.median(np.concatenate([r.sigma_f for r in own])))
         sz = float(np.median(np.concatenate([r.sigma_zeta for r in own])))

@@ -39,9 +39,11 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from ..calibrate._readouts import QUAD
 from ..io import level_column
 from ..io.contract import UNUSABLE
+from ..io.testkinds import run_test_kind
+from ..measure.testkinds import level_readout
+from ..measure.testkinds.ringdown import METHOD as WINDOWS
 from ..models.free_decay import free_backbone
 from ..validate.decay import scales
 from ..validate.testkinds import measured_read
@@ -109,7 +111,7 @@ def _points(backbone: pd.DataFrame, modal: pd.DataFrame, rows: Sequence[Mapping]
     """(row, its points q_in, f_hz, zeta) of each run: a ring-down's windows; each level's dwells once."""
     mrows = modal.set_index("run_id") if "run_id" in modal else pd.DataFrame()
     out, levels_done = [], set()
-    bb = backbone[backbone["test"] == "ringdown"] if len(backbone) else backbone
+    bb = backbone[backbone["test"] == WINDOWS] if len(backbone) else backbone
     for row in rows:
         rid = str(row["run_id"])
         r = {**(mrows.loc[rid].to_dict() if rid in mrows.index else {}), **dict(row), "run_id": rid}
@@ -120,8 +122,9 @@ def _points(backbone: pd.DataFrame, modal: pd.DataFrame, rows: Sequence[Mapping]
         if len(w):
             out.append((r, w.sort_values("q_in", ascending=False).reset_index(drop=True)))
         col = level_column(r)
-        quad = [float(pd.to_numeric(r.get(c), errors="coerce")) for c in QUAD]
-        if str(r.get("test")) == "dwell" and all(np.isfinite(quad)) and min(quad) > 0:
+        cols = level_readout(run_test_kind(r).name) or ()  # a dwell's: its level's phase resonance, one read-out
+        quad = [float(pd.to_numeric(r.get(c), errors="coerce")) for c in cols]
+        if quad and all(np.isfinite(quad)) and min(quad) > 0:
             key = (col, r.get(col))
             if key not in levels_done:  # a level's phase resonance, once for its dwells
                 levels_done.add(key)
@@ -156,7 +159,7 @@ def decay_runs(backbone: pd.DataFrame, modal: pd.DataFrame, rows: Sequence[Mappi
     backbone : DataFrame
         backbone.csv's rows (run_id, mode, test, q_in, f_hz, zeta) of this unit.
     modal : DataFrame
-        modal_properties.csv's rows of this unit (flags; a dwell's phase resonance, `QUAD`).
+        modal_properties.csv's rows of this unit (flags; a dwell's phase resonance, its estimator's ``level_readout``).
     rows : sequence of mapping
         The runs' manifest rows (run_id, test, level, sequence).
     floor_db, floor_deg : float

@@ -40,7 +40,7 @@ import pandas as pd
 from ..calibrate.space import PARAMS, ParamSpace
 from ..effects import EFFECTS, effects_of
 from ..calibrate.kind import backbone_at
-from ..io import level_column, test_kind
+from ..io import level_column, run_test_kind
 from ..io.contract import LEVEL
 from ..validate.drive import drive_gain
 from ..validate.testkinds import as_read
@@ -142,7 +142,7 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     # each run read as the modal stage read it (its frequency; a decay through the force with its measured
     # constants), as the validation stage reads it: E before and after from the same read-out of the same records
     rows = as_read(rows, mine)
-    if backbone is not None and not any(test_kind(r) == "sweep" for r in rows):  # ring-downs and dwells alone
+    if backbone is not None and not any(run_test_kind(r).swept for r in rows):  # ring-downs and dwells alone
         return diagnose_decays(assembly, backbone, mine, best, records, rows, space=space, scales=scales,
                                settings=settings, validate_settings=validate_settings,
                                vkw=dict(envelopes_kw=envelopes_kw, modal_kw=modal_kw, executor=executor),

@@ -14,6 +14,10 @@ Modules, in the order a record flows through them:
 
 * `contract` (public): the contract's names, units and errors; `excitation_kind`, the one rule
   that tells a run's excitation from its columns or its level column.
+* `testkinds` (public): the test kinds (the manifest's ``test``: ``sweep``, ``dwell``,
+  ``ringdown``), one module each in a registry like `jointcal.effects`: a kind's manifest
+  columns, its row's checks, the band its drive is checked over, whether its reference may be
+  absent; `run_test_kind(row)` is what the stages ask instead of comparing names.
 * `_manifest`: ``manifest.csv``, every row checked (`read_manifest`).
 * `_records`: one record, the contract's CSV or MAT (`read_run`), a whole campaign
   (`ingest_campaign`), a manifest file among a rule's inputs (`listed_record`).
@@ -33,12 +37,12 @@ from __future__ import annotations
 from jointcal.io.contract import CampaignError, CampaignWarning, excitation_kind, level_column
 from jointcal.io._atomic import write_bytes_atomic, write_csv_atomic, write_json_atomic, write_run
 from jointcal.io._checks import UNUSABLE_FLAGS, validate_run
-from jointcal.io._kinds import kind_of as test_kind
+from jointcal.io.testkinds import run_test_kind, test_kind
 from jointcal.io._manifest import read_manifest
 from jointcal.io._records import ingest_campaign, listed_record, read_run
 
 __all__ = [
     "CampaignError", "CampaignWarning", "excitation_kind", "level_column", "read_manifest", "read_run",
     "validate_run", "ingest_campaign", "listed_record", "write_bytes_atomic", "write_csv_atomic",
-    "write_json_atomic", "write_run", "UNUSABLE_FLAGS", "test_kind",
+    "write_json_atomic", "write_run", "UNUSABLE_FLAGS", "test_kind", "run_test_kind",
 ]

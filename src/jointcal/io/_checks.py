@@ -15,14 +15,14 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from jointcal.io._amplitudes import level_problems, swap_problem, window_amplitudes
-from jointcal.io._band import check_head, drive_band, dwell_band
+from jointcal.io._band import check_head
 from jointcal.io._clipping import clip_levels, clipped_mask
 from jointcal.io._dead import dead_problem
 from jointcal.io.contract import (
     LEVEL, REFERENCE, RESPONSE, TIME, CampaignError, CampaignWarning, OnDataProblem,
     excitation_kind, excitation_of, fail,
 )
-from jointcal.io._kinds import DWELL, kind_of
+from jointcal.io.testkinds import run_test_kind
 from jointcal.io._time import check_time, time_resolution
 
 __all__ = ["validate_run", "clipped_mask", "clip_levels", "window_amplitudes", "time_resolution", "UNUSABLE_FLAGS"]
@@ -116,16 +116,11 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
     ref = REFERENCE[kind]
     chans = {c: df[c].to_numpy(np.float64) for c in (ref, RESPONSE)}
     fs = check_time(t, float(row["sample_rate_hz"]), path, run)
-    test = kind_of(row)
-    if test == "ringdown":
-        return _ringdown_checks(t, chans, fs, kind, clip_run, path, run, on_data_problem)
-    if test == "dwell":  # its amplitude checks over the dwell, as over a sweep of one frequency
-        live = chans[ref][np.isfinite(chans[ref])]
-        f0, f1, rate, f_meas = (dwell_band(chans[ref], fs, float(row[DWELL]), path, run, chans[RESPONSE])
-                                if live.size and live.min() < live.max() else (float(row[DWELL]),) * 2 + (1.0, np.nan))
-        row = {**row, "f_start_hz": f0, "f_stop_hz": f1, "sweep_rate_hz_per_s": rate}
-    else:
-        f0, f1, rate = float(row["f_start_hz"]), float(row["f_stop_hz"]), float(row["sweep_rate_hz_per_s"])
+    test = run_test_kind(row)
+    if test.band is None:  # no drive over a band (`jointcal.io.testkinds`)
+        return _channel_checks(t, chans, fs, kind, clip_run, path, run, on_data_problem, test.unchecked)
+    f0, f1, rate, f_meas = test.band(row, chans[ref], chans[RESPONSE], fs, path, run)
+    row = {**row, "f_start_hz": f0, "f_stop_hz": f1, "sweep_rate_hz_per_s": rate}  # a dwell: a sweep of one frequency
     sweep_s = abs(f1 - f0) / rate
     band = f"{f0:g} -> {f1:g} Hz at {rate:g} Hz/s"
     if t.size / fs < 0.95 * sweep_s:
@@ -143,11 +138,8 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
     drive = chans[RESPONSE if swapped else ref]
     if ref in silent:  # no drive to measure: the flag says why, not a misleading band error
         f_first = f_last = tol = float("nan")
-    elif test == "dwell":
-        f_first = f_last = f_meas
-        tol = fs * 2 / t.size + 1e-3 * f0
     else:
-        f_first, f_last, tol = drive_band(drive, fs, f0, f1, rate)
+        f_first, f_last, tol = test.drive_ends(drive, fs, f0, f1, rate, f_meas, t.size)
     for label, got, exp in (("start", f_first, f0), ("end", f_last, f1)):
         if abs(got - exp) > tol:
             check_head(drive, amp[RESPONSE if swapped else ref], fs, f0, f1, rate, path, run, band)
@@ -172,10 +164,12 @@ def validate_run(df: pd.DataFrame, row: Mapping[str, Any], path: str | os.PathLi
             "flags": flags}
 
 
-def _ringdown_checks(t: NDArray[np.float64], chans: dict[str, NDArray[np.float64]], fs: float, kind: str,
-                     clip_run: int, path: object, run: str, on_data_problem: OnDataProblem) -> dict[str, Any]:
-    """A ring-down's checks: its channels' data problems (a reference cut to zero or an impact's short
-    pulse is no problem: only its NaN/inf values count); no band, level or drive-following checks."""
+def _channel_checks(t: NDArray[np.float64], chans: dict[str, NDArray[np.float64]], fs: float, kind: str,
+                    clip_run: int, path: object, run: str, on_data_problem: OnDataProblem,
+                    unchecked: str) -> dict[str, Any]:
+    """The checks of a kind with no drive over a band (a ring-down): its channels' data problems (a reference cut
+    to zero or an impact's short pulse is no problem: only its NaN/inf values count); no band, level or
+    drive-following checks (`unchecked` says why, in ``response_units_check``)."""
     flags: list[str] = []
     problems = _data_problems(t, chans, clip_run, path, run)
     _report([p for p in problems if p[0].endswith(RESPONSE) or p[0].startswith("nonfinite")], flags, on_data_problem)
@@ -185,7 +179,7 @@ def _ringdown_checks(t: NDArray[np.float64], chans: dict[str, NDArray[np.float64
     nan = float("nan")
     return {"n_samples": t.size, "duration_s": t.size / fs, "fs_measured_hz": fs, "excitation": kind, **rms,
             "f_first_hz": nan, "f_last_hz": nan, "f_tolerance_hz": nan,
-            "response_units_check": "not checkable: a ring-down holds no drive over a band", "flags": flags}
+            "response_units_check": unchecked, "flags": flags}
 
 
 def _data_problems(t: NDArray[np.float64], chans: dict[str, NDArray[np.float64]], clip_run: int,

@@ -15,8 +15,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from jointcal.io.contract import LEVEL, POSITIVE, START, TEXT, CampaignWarning, fail
-from jointcal.io._kinds import DWELL, REF_FILE, SWEEP_ONLY, TEST, manifest_kind
+from jointcal.io.contract import LEVEL, POSITIVE, REF_FILE, TEXT, CampaignWarning, fail
+from jointcal.io.testkinds import DEFAULT, TEST, TEST_KINDS, kind_columns, manifest_kind
 
 __all__ = ["read_manifest", "check_csv_text"]
 
@@ -42,7 +42,7 @@ def read_manifest(path: str | os.PathLike[str]) -> pd.DataFrame:
         starts with the sweep), ``reference_channel`` and ``response_channel`` (the
         channel names in a lab format's file), ``test`` (the run's kind: ``sweep``,
         the default when the column is absent or the cell empty, ``dwell`` or ``ringdown``;
-        `jointcal.io._kinds`) and ``dwell_hz`` (Hz, a dwell's drive frequency). A run of
+        `jointcal.io.testkinds`) and ``dwell_hz`` (Hz, a dwell's drive frequency). A run of
         another kind than ``sweep`` may leave ``direction``, ``f_start_hz``, ``f_stop_hz``
         and ``sweep_rate_hz_per_s`` empty, and a campaign without sweeps may leave those
         columns out. Extra columns are kept.
@@ -81,8 +81,10 @@ def read_manifest(path: str | os.PathLike[str]) -> pd.DataFrame:
              "give level_g for base-driven, level_lbf for force-driven or level_V for voltage-driven campaigns")
     need = ["run_id", "assembly", "sequence", levels[0], "direction", *POSITIVE, "file"]
     kinds = raw[TEST].str.strip().str.lower() if TEST in raw.columns else pd.Series("", index=raw.index)
-    header = [c for c in need if c not in SWEEP_ONLY or kinds.isin(["", "sweep"]).any()]
-    header += [DWELL] if (kinds == "dwell").any() else []
+    present = [k for k in TEST_KINDS.values() if kinds.replace("", DEFAULT).isin([k.name]).any()]
+    needed = {c for k in present for c in k.needs}  # the columns of the kinds the campaign holds
+    header = [c for c in need if c not in kind_columns() or c in needed]
+    header += [c for k in present for c in k.needs if c not in header]
     missing = [c for c in header if c not in raw.columns]
     if missing:
         fail(path, f"column(s) {', '.join(missing)} missing (found: {', '.join(raw.columns)})",
@@ -209,10 +211,10 @@ def _manifest_row(rec: dict[str, str], path: Path, line: int, level: str) -> dic
     kind = manifest_kind(rec, where)
     if TEST in out:
         out[TEST] = kind.name
-    needed = [c for c in (*TEXT, "sequence", level, *POSITIVE) if c not in SWEEP_ONLY] + list(kind.needs)
+    needed = [c for c in (*TEXT, "sequence", level, *POSITIVE) if c not in kind_columns()] + list(kind.needs)
     for col in needed:
         if not out.get(col, ""):
-            what = "" if kind.name == "sweep" else f" (a {kind.name} run needs it)"
+            what = "" if kind.name == DEFAULT else f" (a {kind.name} run needs it)"
             fail(where, f"{col} is empty{what}", f"fill in {col}")
     try:
         out["sequence"] = int(out["sequence"])
@@ -221,7 +223,8 @@ def _manifest_row(rec: dict[str, str], path: Path, line: int, level: str) -> dic
     if out["sequence"] < 1:
         fail(where, f"sequence {rec['sequence'].strip()!r} is not an integer >= 1",
              "number the runs of each assembly 1, 2, 3, ... in test order")
-    for col in (level, *POSITIVE, DWELL):
+    numbers = dict.fromkeys(c for k in TEST_KINDS.values() for c in k.numbers if c not in POSITIVE)
+    for col in (level, *POSITIVE, *numbers):
         if col not in out or (col not in needed and not out[col]):
             if col in out or col in POSITIVE:
                 out[col] = float("nan")  # a column this kind does not need, left empty
@@ -232,42 +235,4 @@ def _manifest_row(rec: dict[str, str], path: Path, line: int, level: str) -> dic
             out[col] = float("nan")
         if not (np.isfinite(out[col]) and out[col] > 0):
             fail(where, f"{col} {rec[col].strip()!r} is not a positive number", f"write {col} as a number > 0")
-    if kind.name != "sweep":
-        return _other_kind_row(out, where, kind.name)
-    return _sweep_row(out, rec, where)
-
-
-def _other_kind_row(out: dict[str, Any], where: str, kind: str) -> dict[str, Any]:
-    """A dwell's or ring-down's row: its frequency below Nyquist; the sweep's words left as given."""
-    out["direction"] = out["direction"].lower()
-    fs = out["sample_rate_hz"]
-    if kind == "dwell" and out[DWELL] >= fs / 2:
-        fail(where, f"dwell_hz {out[DWELL]:g} Hz is above Nyquist ({fs / 2:g} Hz)",
-             "check dwell_hz and sample_rate_hz")
-    return out
-
-
-def _sweep_row(out: dict[str, Any], rec: dict[str, str], where: str) -> dict[str, Any]:
-    """A sweep's row: its start, direction and band checked (the contract before test kinds)."""
-    if START in out:
-        text = out[START]
-        try:
-            out[START] = float(text) if text else 0.0
-        except ValueError:
-            out[START] = float("nan")
-        if not (np.isfinite(out[START]) and out[START] >= 0):
-            fail(where, f"{START} {text!r} is not a number >= 0",
-                 "write the sweep's start in seconds after the record's first sample (empty or 0 when the record "
-                 "starts with the sweep)")
-    out["direction"] = out["direction"].lower()
-    f0, f1, fs = out["f_start_hz"], out["f_stop_hz"], out["sample_rate_hz"]
-    if out["direction"] not in ("up", "down"):
-        fail(where, f"direction {rec['direction'].strip()!r} is not up or down", "write up or down")
-    if (out["direction"] == "up") != (f0 < f1) or f0 == f1:
-        sweep = "an up" if out["direction"] == "up" else "a down"
-        fail(where, f"{sweep} sweep cannot go from {f0:g} Hz to {f1:g} Hz",
-             "use f_start_hz < f_stop_hz for up and f_start_hz > f_stop_hz for down")
-    if max(f0, f1) >= fs / 2:
-        fail(where, f"the band reaches {max(f0, f1):g} Hz, above Nyquist ({fs / 2:g} Hz)",
-             "check the band and sample_rate_hz")
-    return out
+    return kind.row(out, rec, where)  # the kind's own checks (`jointcal.io.testkinds`)

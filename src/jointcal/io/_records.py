@@ -16,10 +16,10 @@ from numpy.typing import NDArray
 
 from jointcal.io._checks import validate_run
 from jointcal.io.contract import (
-    CHANNEL_COLUMNS, LEVEL, REFERENCE, RESPONSE, RESPONSE_SI, START, TIME, Excitation, OnDataProblem,
+    CHANNEL_COLUMNS, LEVEL, REF_FILE, REFERENCE, RESPONSE, RESPONSE_SI, START, TIME, Excitation, OnDataProblem,
     excitation_kind, excitation_of, fail,
 )
-from jointcal.io._kinds import REF_FILE, kind_of
+from jointcal.io.testkinds import run_test_kind
 from jointcal.io._lab_formats import LAB_SUFFIXES, is_testlab, read_lab_export
 from jointcal.io._manifest import check_csv_text, read_manifest
 from jointcal.units import G_SI
@@ -71,7 +71,7 @@ def read_run(path: str | os.PathLike[str], row: Mapping[str, Any] | None = None)
     name = path.name.lower()
     kind = _row_excitation(row)
     channels = {role: _cell(row, col) for role, col in CHANNEL_COLUMNS.items()} if row is not None else {}
-    lab = {"reference_path": _reference_path(path, row), "no_reference": row is not None and kind_of(row) == "ringdown"}
+    lab = {"reference_path": _reference_path(path, row), "no_reference": row is not None and run_test_kind(row).reference_optional}
     if name.endswith(".mat"):
         cols, attrs = _read_mat(path, kind, channels, row, lab)
     elif name.endswith((".csv", ".csv.gz")):

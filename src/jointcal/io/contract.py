@@ -11,7 +11,7 @@ from typing import Literal, NoReturn
 
 from jointcal.units import FOOT_IN, G, G_SI, INCH_M, LBF_N
 
-__all__ = ["Excitation", "OnDataProblem", "TIME", "RESPONSE", "REFERENCE", "LEVEL", "RESPONSE_SI", "TEXT", "START",
+__all__ = ["Excitation", "OnDataProblem", "TIME", "RESPONSE", "REFERENCE", "LEVEL", "RESPONSE_SI", "TEXT", "START", "REF_FILE",
            "CHANNEL_COLUMNS", "POSITIVE", "QUANTITY", "UNITS", "SI_UNIT", "FS_RTOL", "MIN_CYCLES", "CampaignError",
            "CampaignWarning", "fail", "excitation_kind", "level_column", "excitation_of", "UNUSABLE"]
 
@@ -26,6 +26,7 @@ LEVEL: dict[str, str] = {"base": "level_g", "force": "level_lbf", "voltage": "le
 RESPONSE_SI = "response_accel_m_s2"
 TEXT = ("run_id", "assembly", "direction", "file")
 START = "sweep_start_s"  # optional manifest column: the sweep's start after the record's first sample (s)
+REF_FILE = "reference_file"  # optional manifest column: the lab export holding the reference, when apart
 # optional manifest columns naming a lab format's channels: role -> column
 CHANNEL_COLUMNS: dict[str, str] = {"reference": "reference_channel", "response": "response_channel"}
 POSITIVE = ("f_start_hz", "f_stop_hz", "sweep_rate_hz_per_s", "sample_rate_hz")

@@ -12,6 +12,9 @@ Modules, in the order a record flows through them (import from the module: this
 * `modal` (with `_envelope_readout` and `_excited`): resonance, damping and amplitude of
   one run, by one read-out rule (`modal.READOUT_RULE`); `modal.measure_run` chains
   envelopes -> modal.
+* `testkinds` (with `ringdown`, `forced_decay`, `dwell`, `receptance`): the runs of the test kinds
+  that are not swept (`jointcal.io.testkinds`), each read by its kind's registered rule, an ordered
+  tuple of estimators (`testkinds.read` reads the record; backbone.csv).
 * `scatter`: the read-outs' spread across repeats and up/down pairs.
 * `peaks`: the small read-outs they and other stages share (half-power, quadrature
   crossing, full-drive frames, transmissibility); the peak parabola and a record's peak

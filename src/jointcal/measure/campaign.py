@@ -36,13 +36,13 @@ import numpy as np
 import pandas as pd
 
 from ..io.contract import LEVEL, REFERENCE, RESPONSE, UNUSABLE, excitation_kind
-from ..io._kinds import kind_of
+from ..io.testkinds import run_test_kind
 from .envelopes import ENVELOPE_COLUMNS
 from .frf import displacement_ratio, h1_estimate
 from .modal import modal_properties
 from .modes import mode_name, modal_peaks, track_modes
 from .receptance import Receptance, flank_receptance
-from .testkinds import other_kinds_modal
+from .testkinds.read import other_kinds_modal
 
 __all__ = ["campaign_modal", "run_peaks", "assembly_coil"]
 
@@ -117,7 +117,7 @@ def campaign_modal(runs: pd.DataFrame, load: Callable[[dict], tuple], modal_kw: 
     with_coil = bool(kw.pop("coil", False))
     loaded, rows, frf, notes, others = {}, [], {}, [], []
     for row in runs.to_dict("records"):
-        if kind_of(row) != "sweep":
+        if not run_test_kind(row).swept:  # read by its kind's read-out rule (`jointcal.measure.testkinds`)
             others.append(row)
             continue
         env, meta, record = load(row)

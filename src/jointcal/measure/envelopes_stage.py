@@ -15,7 +15,7 @@ from typing import Any
 
 import pandas as pd
 
-from ..io import listed_record, read_run, test_kind, write_csv_atomic, write_json_atomic
+from ..io import listed_record, read_run, run_test_kind, write_csv_atomic, write_json_atomic
 from .envelopes import ENVELOPE_COLUMNS, envelopes, meta_dict
 
 __all__ = ["run_envelopes"]
@@ -25,9 +25,10 @@ _Path = str | os.PathLike[str]
 
 def _one_run(path: str, row: dict, settings: dict, env_file: str, meta_file: str) -> tuple[str, bool]:
     """Write one run's envelopes and metadata; return its log line and whether it is a warning."""
-    env, meta = pd.DataFrame(columns=list(ENVELOPE_COLUMNS)), {"error": "", "test": test_kind(row)}
-    note = (f"{row['run_id']}: a {meta['test']} run, no sweep envelopes", False)  # read by modal from its record
-    if meta["test"] == "sweep":
+    test = run_test_kind(row)
+    env, meta = pd.DataFrame(columns=list(ENVELOPE_COLUMNS)), {"error": "", "test": test.name}
+    note = (f"{row['run_id']}: a {test.name} run, no sweep envelopes", False)  # read by modal from its record
+    if test.swept:
         try:
             env, m = envelopes(read_run(path, row), row, **settings)
             meta = {**meta_dict(m), "error": ""}

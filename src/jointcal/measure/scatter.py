@@ -5,6 +5,7 @@ import numpy as np
 import pandas as pd
 
 from ..io.contract import UNUSABLE, level_column
+from .testkinds import methods
 
 __all__ = ["scatter"]
 
@@ -23,7 +24,7 @@ def scatter(table: pd.DataFrame) -> pd.DataFrame:
     level = level_column(table.columns) or "level_g"
     ok = ~table["flags"].fillna("").str.contains(UNUSABLE)
     if "f_res_method" in table.columns:
-        ok &= ~table["f_res_method"].isin(["dwell", "ringdown"])
+        ok &= ~table["f_res_method"].isin(methods())  # the test kinds' read-outs (`jointcal.measure.testkinds`)
     keys = ["assembly", "mode"] if "mode" in table.columns else ["assembly"]
     rows = []
     for key, grp in table[ok].groupby(keys, sort=False):

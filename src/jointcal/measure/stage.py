@@ -4,7 +4,7 @@ the amplitude-dependent points, written.
 Outputs (all written atomically): ``modal_properties.csv`` (one row per run and mode its band holds,
 `jointcal.measure.campaign.campaign_modal`), ``scatter.csv`` (`jointcal.measure.scatter.scatter`),
 ``backbone.csv`` (every run's amplitude-dependent points from every test kind,
-`jointcal.measure.testkinds.backbone_table`) and ``frf/<run_id>.csv`` (each run's whole-record FRF,
+`jointcal.measure.testkinds.read.backbone_table`) and ``frf/<run_id>.csv`` (each run's whole-record FRF,
 `jointcal.measure.frf.frf_table`). A run with problems gets flags and a one-sentence warning, never a
 silent drop. `run_modal_unit` then cuts one (assembly, mode)'s rows out of the three tables, the files the
 later stages of that unit read.
@@ -24,7 +24,7 @@ from .campaign import campaign_modal
 from .flags import run_flags
 from .frf import frf_table
 from .scatter import scatter
-from .testkinds import backbone_table
+from .testkinds.read import backbone_table
 
 __all__ = ["run_modal", "run_modal_unit"]
 

@@ -5,6 +5,8 @@ from collections.abc import Mapping
 
 import pandas as pd
 
+from ..measure.testkinds.ringdown import METHOD as DECAY  # the validation frames' part of a decay's windows
+
 __all__ = ["residual_map_figure", "before_after_figure", "decay_residual_figure", "decay_before_after_figure"]
 
 
@@ -109,9 +111,9 @@ def decay_before_after_figure(frames_before: Mapping[str, pd.DataFrame], frames_
     for i, rid in enumerate(sorted(frames_after)):
         for j, frames in enumerate((frames_after, frames_before)):
             a = frames.get(rid)
-            if a is None or "part" not in a or not (a["part"] == "ringdown").any():
+            if a is None or "part" not in a or not (a["part"] == DECAY).any():
                 continue
-            a = a[a["part"] == "ringdown"].sort_values("q_meas_in")
+            a = a[a["part"] == DECAY].sort_values("q_meas_in")
             for ax, col in zip(axes, ("f", "zeta")):
                 meas, sim = (f"{col}_meas_hz", f"{col}_sim_hz") if col == "f" else ("zeta_meas", "zeta_sim")
                 if j == 0:

@@ -12,7 +12,7 @@ from typing import Any
 
 import pandas as pd
 
-from ..io import level_column, listed_record, read_run, test_kind
+from ..io import level_column, listed_record, read_run, run_test_kind
 from ..measure.envelopes import window_length
 from .modal import plot_envelopes, plot_frequency_damping, plot_spectrogram
 
@@ -52,7 +52,7 @@ def run_modal_figures(table_csv: _Path, runs_csv: _Path, envelope_files: Sequenc
     table = pd.read_csv(table_csv, dtype={"flags": str})
     runs = pd.read_csv(runs_csv, dtype={"flags": str}).set_index("run_id", drop=False)
     envs = {Path(p).stem: pd.read_csv(p) for p in envelope_files}
-    sweeps = runs[[test_kind(r) == "sweep" for r in runs.to_dict("records")]]
+    sweeps = runs[[run_test_kind(r).swept for r in runs.to_dict("records")]]
     plot_envelopes(table[table["run_id"].isin(sweeps["run_id"])], envs, envelopes_png)
     plot_frequency_damping(table, amplitude_png)
     level = level_column(runs.columns) or "level_g"

@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 
 from ..io.contract import LEVEL, excitation_kind
+from ..io.testkinds import swept_mask
 from .calibration import _figure, _png
 
 __all__ = ["validation_figure"]
@@ -40,7 +41,7 @@ def _pick(metrics: pd.DataFrame) -> pd.DataFrame:
     no envelope over frequency)."""
     m = metrics[metrics["n_frames"] > 0]
     if "test" in m:
-        m = m[m["test"] == "sweep"]
+        m = m[swept_mask(m["test"])]
     return m.sort_values("sequence").groupby(["level", "direction"], sort=True).head(1)
 
 

@@ -19,6 +19,7 @@ from dataclasses import replace
 
 from ..effects import EFFECTS
 from ..io import write_csv_atomic, write_json_atomic, write_run
+from ..io.testkinds import DEFAULT, TEST_KINDS, is_swept
 from ..models import resonance_amplitude, simulate
 from ..units import G
 from . import daq, dwell, ringdown
@@ -50,9 +51,10 @@ def plan_runs(spec: dict) -> pd.DataFrame:
     for assembly in spec["assemblies"]:
         seq = int(spec.get("first_sequence", 1)) - 1  # a campaign generated in parts continues its sequence
         for item in spec["series"]:
-            if item.get("test", "sweep") != "sweep":  # dwells or ring-downs: one run per drive frequency
-                if item["test"] not in PLANS:
-                    raise ValueError(f"series item {item}: test must be sweep, dwell or ringdown.")
+            test = item.get("test", DEFAULT)
+            if test not in TEST_KINDS or not TEST_KINDS[test].swept:  # dwells or ring-downs: a run per frequency
+                if test not in PLANS:
+                    raise ValueError(f"series item {item}: test must be {DEFAULT} or one of {', '.join(PLANS)}.")
                 seq = PLANS[item["test"]](rows, item, assembly, seq, ref, float(spec["sample_rate_hz"]),
                                           spec["file_format"])
                 continue
@@ -70,7 +72,7 @@ def plan_runs(spec: dict) -> pd.DataFrame:
                                      file=f"runs/{run_id}.{spec['file_format']}"))
     plan = pd.DataFrame(rows)
     if "test" in plan:  # a campaign with dwells or ring-downs: the sweeps say so too
-        plan["test"] = plan["test"].fillna("sweep")
+        plan["test"] = plan["test"].fillna(DEFAULT)
     return plan
 
 
@@ -147,7 +149,7 @@ def generate(spec: dict | str | os.PathLike, out_dir: str | os.PathLike, truth_p
         model = _model(truth, row.sequence, effect, eparams, spec["effect"].get("also"))
         level = row.level_g if ref == "base" else row.level_V
         # base: the controller holds the base acceleration (ripple); a rig's amplifier is open loop
-        swept = getattr(row, "test", "sweep") == "sweep"
+        swept = is_swept(getattr(row, "test", DEFAULT))
         f0, f1, rate, tail = ((row.f_start_hz, row.f_stop_hz, row.sweep_rate_hz_per_s, sw["tail_s"])
                               if swept else dwell.drive_band(row))
         # a dwell's drive is cut off, not ramped down: its ring-down starts from the steady state

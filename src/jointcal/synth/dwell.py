@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..io.testkinds import DWELL, TEST_KINDS
+
 __all__ = ["plan", "drive_band", "PRIVATE", "TINY"]
 
 TINY = 1e-9  # the dwell's relative band: one frequency, the sweep's drive generator
@@ -49,7 +51,7 @@ def held_drive_rows(rows: list[dict], item: dict, assembly: str, seq: int, ref: 
             level = {key: float(item[key])} if ref != "force" else {"level_V": float(item[key]), "level_lbf": np.nan}
             rows.append(dict(run_id=run_id, assembly=assembly, sequence=seq, **level, direction="",
                              f_start_hz=np.nan, f_stop_hz=np.nan, sweep_rate_hz_per_s=np.nan, sample_rate_hz=fs,
-                             file=f"runs/{run_id}.{fmt}", test=kind, dwell_hz=f if kind == "dwell" else np.nan,
+                             file=f"runs/{run_id}.{fmt}", test=kind, dwell_hz=f if DWELL in TEST_KINDS[kind].needs else np.nan,
                              drive_hz=f, dwell_s=float(item.get("dwell_s", 1.0)),
                              decay_s=float(item.get("decay_s", 0.5))))
     return seq

@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 from ..io.contract import LEVEL, excitation_kind
-from ..io._kinds import kind_of
+from ..io.testkinds import DEFAULT, run_test_kind, swept_mask
 from ..models import MinistackModel
 from .error import describe_misfit, envelope_error, repeat_scatter
 from .runs import (band_frames, compare_run, draw_transmissibility, full_drive_fraction, measure_pair,
@@ -89,7 +89,7 @@ class Validation:
 
 def _one_run(model: MinistackModel, record: pd.DataFrame, row: dict, draws: Sequence[MinistackModel],
              s: ValidateSettings, envelopes_kw: dict | None, modal_kw: dict | None):
-    if kind_of(row) != "sweep":  # a dwell or ring-down: its point and decay (no predictive band)
+    if not run_test_kind(row).swept:  # a dwell or ring-down: its point and decay (no predictive band)
         frames, metrics = validate_test_run(model, record, row, floor_db=s.floor_db, floor_deg=s.floor_deg)
         return frames, {**metrics, "draws_s": 0.0, "n_draws": 0}, None
     t0 = time.perf_counter()
@@ -175,8 +175,8 @@ def validate_runs(models: Sequence[MinistackModel] | Callable[[dict], MinistackM
     metrics = pd.DataFrame([mt for _, mt, _ in results])
     swept = metrics
     if "test" in metrics:  # dwells or ring-downs among the runs: every row names its kind; the scale is the sweeps'
-        metrics.insert(list(metrics.columns).index("n_frames"), "test", metrics.pop("test").fillna("sweep"))
-        swept = metrics[metrics["test"] == "sweep"]
+        metrics.insert(list(metrics.columns).index("n_frames"), "test", metrics.pop("test").fillna(DEFAULT))
+        swept = metrics[swept_mask(metrics["test"])]
     scale = repeat_scatter(frames, swept, floor_db=settings.floor_db, floor_deg=settings.floor_deg)
     error = envelope_error(frames, metrics, scale)
     return Validation(metrics=metrics, frames=frames, scale=scale, error=error, traces=traces,

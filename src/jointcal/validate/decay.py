@@ -33,10 +33,11 @@ from numpy.typing import NDArray
 
 from ..io.contract import REFERENCE
 from ..measure.ringdown import ringdown_at
+from ..measure.testkinds.ringdown import METHOD as PART
 from ..models import MinistackModel
 from .drive import model_input, reference_column, response_to
 
-__all__ = ["decay_input", "decay_from_cut", "scales", "compare_decay", "TOL", "TRIES", "RAMP", "BEYOND"]
+__all__ = ["decay_input", "decay_from_cut", "scales", "compare_decay", "TOL", "TRIES", "RAMP", "BEYOND", "PART"]
 
 TOL = 0.002  # the model's first decay window's amplitude within this share of the measured one's
 TRIES = 8  # simulations at most to reach it
@@ -191,7 +192,7 @@ def compare_decay(meas: pd.DataFrame, sim: pd.DataFrame, *, floor_db: float = 0.
     sf, sz = scales(meas, floor_db=floor_db, floor_deg=floor_deg)
     d_f, d_z = f_s / meas["f_hz"].to_numpy(float) - 1, z_s / meas["zeta"].to_numpy(float) - 1
     frames = pd.DataFrame(dict(
-        part="ringdown", t_s=meas["t_s"].to_numpy(float), window_s=meas["window_s"].to_numpy(float), q_meas_in=q_m,
+        part=PART, t_s=meas["t_s"].to_numpy(float), window_s=meas["window_s"].to_numpy(float), q_meas_in=q_m,
         q_sim_in=q_s, d_env_db=20 * np.log10(q_s / q_m), f_meas_hz=meas["f_hz"].to_numpy(float), f_sim_hz=f_s,
         zeta_meas=meas["zeta"].to_numpy(float), zeta_sim=z_s, d_f_rel=d_f, d_zeta_rel=d_z, sigma_f_rel=sf,
         sigma_zeta_rel=sz, r_f=d_f / sf, r_zeta=d_z / sz, in_range=inside))

@@ -11,6 +11,8 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 
+from ..io.testkinds import DEFAULT, is_swept, swept_mask
+
 __all__ = ["BINS", "repeat_scatter", "own_noise", "envelope_error", "scale_source", "scale_words", "closeness",
            "describe_misfit"]
 
@@ -207,12 +209,12 @@ def envelope_error(frames: Mapping[str, pd.DataFrame], metrics: pd.DataFrame, sc
     """
     sm = scale["sigma_mag_db"].to_numpy()
     sp = scale["sigma_phase_deg"].to_numpy()
-    tests = metrics["test"] if "test" in metrics else pd.Series("sweep", index=metrics.index)
+    tests = metrics["test"] if "test" in metrics else pd.Series(DEFAULT, index=metrics.index)
     per_run = []
     for (_, r), test in zip(metrics.iterrows(), tests):
         if not r["n_frames"] > 0:
             continue
-        if test != "sweep":
+        if not is_swept(test):  # a dwell's point or a decay: its parts of E (`jointcal.validate.testkinds`)
             per_run.append((r["level"], test, *(float(r.get(k, np.nan)) ** 2 for k in _PARTS)))
             continue
         d = frames[r["run_id"]]
@@ -225,7 +227,7 @@ def envelope_error(frames: Mapping[str, pd.DataFrame], metrics: pd.DataFrame, sc
     t = pd.DataFrame(per_run, columns=["level", "test", "m2", "p2", "f2", "z2"])
     out = _parts(t)
     out["per_level"] = {f"{lev:g}": _parts(g) for lev, g in t.groupby("level", sort=True)}
-    if set(t["test"]) != {"sweep"}:
+    if not swept_mask(t["test"]).all():
         out["per_test"] = {k: _parts(g) for k, g in t.groupby("test", sort=True)}
     else:
         for d in (out, *out["per_level"].values()):
@@ -286,12 +288,12 @@ def describe_misfit(metrics: pd.DataFrame, err: Mapping, *, level_unit: str = "g
     if m.empty:
         return "no usable run to compare."
     src = scale_source(err.get("scale"))
-    if "test" in m and (m["test"] != "sweep").any():
-        swept = m[m["test"] == "sweep"]
+    if "test" in m and not swept_mask(m["test"]).all():
+        swept = m[swept_mask(m["test"])]
         words = [_first_words(m, err, src, swept.empty)]
         if not swept.empty:
             words += _sweep_words(swept, level_unit)
-        return " ".join(words + _other_words(m[m["test"] != "sweep"]))
+        return " ".join(words + _other_words(m[~swept_mask(m["test"])]))
     verdict = closeness(err["E"], src)
     words = [f"validation envelope error E = {err['E']:.2f} (magnitude {err['E_mag']:.2f}, phase "
              f"{err['E_phase']:.2f}; 1 = {scale_words(src)}): {verdict}."]

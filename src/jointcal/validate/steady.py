@@ -14,6 +14,8 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 
+from ..measure.testkinds.dwell import STEADY
+
 __all__ = ["compare_dwell"]
 
 
@@ -49,7 +51,7 @@ def compare_dwell(meas: Mapping, sim: Mapping, *, floor_db: float = 0.05,
     s_deg = max(floor_deg, float(np.degrees(change)))
     d_db, d_deg = 20 * np.log10(abs(d)), float(np.degrees(np.angle(d)))
     frame = pd.DataFrame([dict(
-        part="dwell", f_hz=float(meas["f_hz"]), mag_meas_db=20 * np.log10(abs(h_m)),
+        part=STEADY.method, f_hz=float(meas["f_hz"]), mag_meas_db=20 * np.log10(abs(h_m)),
         mag_sim_db=20 * np.log10(abs(h_s)), phase_meas_deg=float(np.degrees(np.angle(h_m))),
         phase_sim_deg=float(np.degrees(np.angle(h_s))), d_mag_db=d_db, d_phase_deg=d_deg, sigma_mag_db=s_db,
         sigma_phase_deg=s_deg, r_mag=d_db / s_db, r_phase=d_deg / s_deg, q_meas_in=float(meas["q_in"]),

@@ -1,6 +1,6 @@
 """A dwell or ring-down run validated as it was done (the sweeps': `jointcal.validate.runs`).
 
-The run is read as the modal stage read it (`jointcal.measure.testkinds.read_test_run`: the same frequency,
+The run is read as the modal stage read it (`jointcal.measure.testkinds.read.read_test_run`: the same frequency,
 decay start, ring-down windows and dwell point), then:
 
 * a dwell's steady point: the model driven by the dwell's record, read by the same lock-in
@@ -20,9 +20,9 @@ import numpy as np
 import pandas as pd
 
 from ..io.contract import excitation_kind
-from ..io._kinds import DWELL, kind_of
+from ..io.testkinds import DWELL, test_kind
 from ..measure.dwell import dwell_point
-from ..measure.testkinds import RECEPTANCE_COLUMNS, read_test_run, row_receptance
+from ..measure.testkinds.read import RECEPTANCE_COLUMNS, read_test_run, row_receptance
 from ..models import MinistackModel
 from .decay import compare_decay, decay_from_cut, decay_input
 from .drive import model_input, reference_column, response_to
@@ -64,7 +64,7 @@ def _mode_hz(row: Mapping) -> float | None:
 
 
 def measured_read(record: pd.DataFrame, row: Mapping) -> dict:
-    """The run's record read as the modal stage read it (`jointcal.measure.testkinds.read_test_run` at the row's
+    """The run's record read as the modal stage read it (`jointcal.measure.testkinds.read.read_test_run` at the row's
     ``mode_hz``, through the force as measured): its dwell point, decay windows, start and flags. It does not depend
     on the model: a caller that validates many models against one record reads it once."""
     return read_test_run(row, record, excitation_kind(record.columns), _mode_hz(row), row_receptance(row))
@@ -100,7 +100,7 @@ def validate_test_run(model: MinistackModel, record: pd.DataFrame, row: Mapping,
     """
     t0 = time.perf_counter()
     row = dict(row)
-    head = {**run_head(row), "test": kind_of(row)}
+    head = {**run_head(row), "test": test_kind(row)}
     fs = float(row["sample_rate_hz"])
     kind = excitation_kind(record.columns)
     read = measured_read(record, row) if read is None else read

@@ -1,7 +1,7 @@
-"""The modal read-out of dwell and ring-down runs, and every run's amplitude-dependent points (backbone.csv).
+"""The runs of the test kinds that are not swept read from their records, and backbone.csv.
 
 A sweep run is read by `jointcal.measure.campaign` as before and gives one point, its read-out.
-The runs of the other test kinds (`jointcal.io.test_kind`), in the order data flows:
+The runs of the other test kinds (`jointcal.io.testkinds`), in the order data flows:
 
 1. **The mode's frequency**: the largest peak of the response's spectrum over its free decay
    (a ring-down, or a dwell's ring-down after the cut), else the dwell's frequency; the nearest of
@@ -20,30 +20,31 @@ The runs of the other test kinds (`jointcal.io.test_kind`), in the order data fl
    where the mode's sweep measured its modal constant and the other modes' receptance R
    (`jointcal.measure.receptance`), each dwell's X - R is read with that constant, however few dwells
    a level holds: an open-loop rig's manifest level is the force each dwell measured, one per dwell.
-
-Each run keeps one row in modal_properties.csv (a ring-down's largest-amplitude window, a dwell's
-point), ``f_res_method`` naming the read-out, so the later stages read it like a sweep's.
+4. **The run's row**: its kind's read-out rule (`jointcal.measure.testkinds.registry.READOUT_RULES`),
+   the first of its estimators that reads it (a ring-down's largest-amplitude window, a dwell's point),
+   ``f_res_method`` naming it, so the later stages read it like a sweep's; ``unusable`` where all refuse.
 """
 from __future__ import annotations
 
 import numpy as np
 import pandas as pd
 
-from ..io.contract import LEVEL, REFERENCE, RESPONSE, UNUSABLE
-from ..io._kinds import DWELL
-from ..spectral import peak_frequency
-from ..units import G
-from .dwell import dwell_mode, dwell_point
-from .forced_decay import forced_decay_backbone
-from .modes import mode_name
-from .receptance import Receptance
-from .ringdown import decay_start, ringdown_backbone
+from ...io.contract import LEVEL, REFERENCE, RESPONSE, UNUSABLE
+from ...io.testkinds import DEFAULT, DWELL, run_test_kind
+from ...spectral import peak_frequency
+from ...units import G
+from ..dwell import dwell_mode, dwell_point
+from ..forced_decay import forced_decay_backbone
+from ..modes import mode_name
+from ..receptance import Receptance
+from ..ringdown import decay_start, ringdown_backbone
+from .registry import READOUT_RULES, methods
+from .ringdown import METHOD as WINDOWS, MIN_DECAY_S
 
 __all__ = ["other_kinds_modal", "backbone_table", "read_test_run", "receptance_row", "row_receptance",
            "BACKBONE_COLUMNS", "RECEPTANCE_COLUMNS", "MIN_DECAY_S", "NEAR"]
 
 BACKBONE_COLUMNS = ["run_id", "mode", "test", "q_in", "f_hz", "zeta"]
-MIN_DECAY_S = 1.0  # a dwell's record this long after the cut holds a ring-down to read (as decay_start asks)
 LIVE = 0.1  # a force reference above this share of its level before the cut over the decay: the shaker stays on
 NEAR = 0.1  # relative distance within which two frequencies are one mode
 IDENTITY = ("run_id", "assembly", "sequence", "direction")
@@ -113,7 +114,7 @@ def read_test_run(row: dict, record: pd.DataFrame, kind: str, mode_hz=None, rece
     start = _decay(resp, ref, fs)
     if start is not None:
         f = _peak_hz(resp[start:], fs, decay=True)
-    elif row.get("test") == "dwell":
+    elif DWELL in run_test_kind(row).needs:  # a dwell: its drive's frequency
         f = float(row[DWELL])
     else:
         f = _peak_hz(resp, fs)
@@ -132,7 +133,7 @@ def read_test_run(row: dict, record: pd.DataFrame, kind: str, mode_hz=None, rece
             out["flags"].append("shaker_on")  # no modal constant measured: not read
     elif start is not None:
         out["windows"] = ringdown_backbone(resp, fs, f, start=start)
-    if row.get("test") == "dwell":
+    if DWELL in run_test_kind(row).needs:
         out["point"] = dwell_point(resp, ref, fs, float(row[DWELL]), kind)
     return out
 
@@ -216,29 +217,13 @@ def other_kinds_modal(rows: list[dict], records: dict, kind: str, swept: dict[st
         row, rid = r["row"], r["row"]["run_id"]
         w = r["windows"]
         if w is not None and len(w):
-            points += [{"run_id": rid, "mode": r["mode"], "test": "ringdown", "q_in": q, "f_hz": f, "zeta": z}
+            points += [{"run_id": rid, "mode": r["mode"], "test": WINDOWS, "q_in": q, "f_hz": f, "zeta": z}
                        for q, f, z in zip(w["q_in"], w["f_hz"], w["zeta"])]
         out = {**{k: row.get(k) for k in IDENTITY}, level: row.get(level), "mode": r["mode"],
                "test": row.get("test"), "mode_peak_hz": r["f_guess"]}
-        flags = []
-        if row.get("test") == "dwell" and np.isfinite(r["dwell"]["f_hz"]):
-            d, p = r["dwell"], r["point"]
-            fit = d["fit"]
-            flags += r["flags"] + p["flags"] + fit["flags"]
-            points.append({"run_id": rid, "mode": r["mode"], "test": "dwell", **{k: d[k] for k in
-                                                                                 ("q_in", "f_hz", "zeta")}})
-            out.update(f_res_hz=d["f_hz"], zeta_res=d["zeta"], q_in=d["q_in"], f_res_method="dwell",
-                       dwell_hz=p["f_hz"], dwell_ratio_re=p["ratio"].real, dwell_ratio_im=p["ratio"].imag,
-                       f_dwell_quad_hz=fit["f_hz"], zeta_dwell_quad=fit["zeta"], q_dwell_quad_in=fit["q_in"],
-                       dwell_residual=fit["residual"], dwell_constant_re=fit["A"].real,
-                       dwell_constant_im=fit["A"].imag)
-        elif w is not None and len(w):  # a ring-down, or a dwell read only along its ring-down
-            flags += r["flags"] + (r["dwell"]["fit"]["flags"] if r.get("dwell") else [])
-            top = w.loc[w["q_in"].idxmax()]
-            out.update(f_res_hz=top["f_hz"], zeta_res=top["zeta"], q_in=top["q_in"], f_res_method="ringdown")
-        else:
-            flags += r["flags"] + (r["dwell"]["fit"]["flags"] if r.get("dwell") else
-                                   [] if r["flags"] else ["no_decay"]) + [UNUSABLE]
+        _, readout, flags, pts = READOUT_RULES[run_test_kind(row).name].read(r)
+        out.update(readout)
+        points += pts
         if r.get("receptance") is not None:  # what the decay was read through: the later stages read it alike
             out.update(receptance_row(r["receptance"]))
         if w is not None and len(w):
@@ -279,9 +264,9 @@ def backbone_table(modal: pd.DataFrame, points: list[dict]) -> pd.DataFrame:
     """
     usable = ~modal["flags"].fillna("").str.contains(UNUSABLE)
     method = modal["f_res_method"] if "f_res_method" in modal else pd.Series("", index=modal.index)
-    sweep = ~method.isin(["dwell", "ringdown"])
+    sweep = ~method.isin(methods())
     rows = modal.loc[usable & sweep].reindex(columns=["run_id", "mode", "q_in", "f_res_hz", "zeta_res"])
-    out = [pd.DataFrame({"run_id": rows["run_id"], "mode": rows["mode"], "test": "sweep", "q_in": rows["q_in"],
+    out = [pd.DataFrame({"run_id": rows["run_id"], "mode": rows["mode"], "test": DEFAULT, "q_in": rows["q_in"],
                          "f_hz": rows["f_res_hz"], "zeta": rows["zeta_res"]})]
     bad = set(modal.loc[~usable, "run_id"])
     out.append(pd.DataFrame([p for p in points if p["run_id"] not in bad], columns=BACKBONE_COLUMNS))
