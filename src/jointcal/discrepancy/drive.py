@@ -23,7 +23,10 @@ moves the slope it finds (on the jointed beam with elastic softening: -0.061i ag
 So when a candidate scores better than the baseline, the slope is refit with it and the library
 scored again; and a named model refits it once more, from its own fit, before its recalibration
 (elastic softening: -0.090i, and the loss ratio 0.37 -> 0.31, truth 0.30). `refine_slope` takes
-any candidate.
+any candidate. A refit slope past any coil's (|A' w_c / A_c| > `MAX_RELATIVE_SLOPE`) is not the drive's:
+the baseline has bent the drive to an effect it misses (on the jointed beam with a neighbouring mode hidden,
+-6.6 + 1.3i, and the neighbour then scored 15 where the read-out's drive leaves it the best), so the read-out's
+drive is kept and the slope reported as rejected.
 
 A force at the driving point is 1/m by physics (real, no slope, `jointcal.measure.sweepfit`):
 its drive is left as the read-out gives it.
@@ -38,9 +41,10 @@ from numpy.typing import NDArray
 from .data import RunEnvelope
 from .fit import Candidate, Fit, Objective
 
-__all__ = ["ROUNDS", "refine_slope"]
+__all__ = ["ROUNDS", "MAX_RELATIVE_SLOPE", "refine_slope"]
 
 ROUNDS = 4  # turns of (joint fit, slope) at most; they stop earlier once the slope moves < 2% of itself
+MAX_RELATIVE_SLOPE = 1.0  # |A' w_c / A_c| of a coil's 1 / (1 + i w tau) is x / sqrt(1 + x^2) < 1, x = w_c tau
 Gain = tuple[complex, complex, float]
 
 
@@ -102,8 +106,13 @@ def refine_slope(c0: Candidate, theta0: NDArray, gain: Gain, build: Callable[[Ga
         theta = fit.theta
         if abs(step) < 0.02 * abs(da):
             break
-    if fit.E >= e0:  # nothing gained: the read-out's drive kept
-        return gain, list(build(gain)), _info(gain, gain, e0, e0)
+    if fit.E >= e0 or abs(da * wc / ac) > MAX_RELATIVE_SLOPE:  # nothing gained, or no coil's slope: the
+        # read-out's drive kept (a slope past a coil's is the baseline bending the drive to an effect it misses:
+        # on the jointed beam with a neighbouring mode hidden, -6.6 + 1.3i)
+        info = _info(gain, gain, e0, e0)
+        if fit.E < e0:
+            info["slope_rejected"] = [float((da * wc / ac).real), float((da * wc / ac).imag)]
+        return gain, list(build(gain)), info
     return (ac, da, wc), runs, _info(gain, (ac, da, wc), e0, fit.E)
 
 

@@ -20,6 +20,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from ..effects import EFFECTS
+from .drive import MAX_RELATIVE_SLOPE
 from .rule import FLOOR_HIGH, NONE_E
 
 __all__ = ["diagnosis_markdown"]
@@ -46,6 +47,11 @@ def _floor(d: Mapping) -> str:
 def _drive(d: Mapping) -> str:
     """A voltage drive's slope refit (`drive.refine_slope`), in a sentence ('' when none was)."""
     v = d.get("voltage_drive")
+    if v and "slope_rejected" in v:
+        r = complex(*v["slope_rejected"])
+        return (f" The voltage drive's slope refit with the baseline, A' w_c / A_c = {r.real:.3f}{r.imag:+.3f}i, is "
+                f"past any coil's (magnitude {MAX_RELATIVE_SLOPE:g}): the baseline bent the drive to what it misses, "
+                "so the read-out's drive is kept.")
     if not v or v["slope_refined"] == v["slope_read_out"]:
         return ""
     a, b = complex(*v["relative_slope_read_out"]), complex(*v["relative_slope_refined"])

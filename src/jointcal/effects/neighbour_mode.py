@@ -45,6 +45,6 @@ def _advice(v):
 EFFECT = Effect(
     "neighbour_mode",
     (EffectParam("f_ratio", "-", 0.2, 5.0, True, 2.0, "the neighbouring mode's frequency over the fitted mode's"),
-     EffectParam("mode_ratio", "-", -3.0, 3.0, False, 0.0, "its modal constant over the fitted mode's")),
+     EffectParam("mode_ratio", "-", -10.0, 10.0, False, 1.0, "its modal constant over the fitted mode's")),
     _apply, _advice, _fingerprint, hidden={"f_ratio": 1.6, "mode_ratio": 0.5}, kinds=("modal",),
     summary="a linear mode at f_ratio x f0 with mode_ratio x the modal constant, read by the same channel")
