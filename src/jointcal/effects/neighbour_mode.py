@@ -5,7 +5,9 @@ the fitted mode the others add a residual, a mass line from the modes above, a s
 line from those below, or a nearby peak. The model adds one linear mode,
 `jointcal.models.Neighbour`: relative acceleration over the (equivalent) base acceleration
 ratio w^2 / (w_n^2 - w^2 + 2 i zeta_n w_n w), w_n = f_ratio x the fitted mode's stuck-joint
-frequency, zeta_n fixed at 1%, ratio its modal constant over the fitted mode's. Both are fitted.
+frequency, zeta_n fixed at 1%, ratio its modal constant over the fitted mode's. Both are fitted; the ratio
+spans -10..10 from 1 (a neighbour of a quarter of the mode's modal mass is 4x its modal constant, and at 0 the
+frequency has no gradient to start from).
 """
 from __future__ import annotations
 
