@@ -7,7 +7,8 @@
    slope out); every later step takes the refined drive. When a candidate scores better
    than the baseline, the slope is refit with it and the library scored again, and a named
    model refits it once more before its recalibration (the baseline's misfit moves the
-   slope it finds).
+   slope it finds). Not where the floor is above the repeat scatter (`rule.FLOOR_HIGH`): the
+   fast model that judges the slope is then further from its record than the slope moves it.
 1. Localise: the baseline (the calibration's optimum, refit on the envelopes) against
    the measured envelopes; residual map and fingerprints (`fingerprints`).
 2. Candidates: the baseline and every library effect (`jointcal.effects.library()`), each refit on
@@ -54,7 +55,7 @@ from .fingerprints import fingerprints, outside_library, residual_map, verdicts
 from .fit import Objective, candidate, model_at, structure_scales
 from .floor import fast_floor
 from .recalibrate import recalibrate
-from .rule import CLAUSES, confirm, decide, needs_pairs, pair_bases, pair_names
+from .rule import CLAUSES, FLOOR_HIGH, confirm, decide, needs_pairs, pair_bases, pair_names
 from .settings import DiscrepancySettings
 from .select import score_candidates
 from .words import diagnosis_markdown
@@ -168,7 +169,10 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
         f"E = {F:.2f}" + ("" if floor["E"] is not None else " (no validation frames to compare: taken as 0)"))
     clock.lap("floor")
     drive = None
-    if gain is not None and level_column(modal.columns) == LEVEL["voltage"]:  # the coil's slope (`drive`)
+    if gain is not None and level_column(modal.columns) == LEVEL["voltage"] and F > FLOOR_HIGH:
+        say(f"{assembly}: the voltage drive's slope not refit: the fast model that would judge it is off its own "
+            f"time simulation by E {F:.2f}, more than the repeat scatter")
+    elif gain is not None and level_column(modal.columns) == LEVEL["voltage"]:  # the coil's slope (`drive`)
         def build(g):
             return _usable_runs(assembly, envs, mrows, [{**r, "drive_gain": g} for r in rows], sdb, sdeg, settings,
                                 zeta_min)

@@ -47,6 +47,10 @@ def _floor(d: Mapping) -> str:
 def _drive(d: Mapping) -> str:
     """A voltage drive's slope refit (`drive.refine_slope`), in a sentence ('' when none was)."""
     v = d.get("voltage_drive")
+    fl = (d.get("fast_model_floor") or {}).get("E")
+    if v is None and d.get("level_unit") == "V" and fl is not None and fl > FLOOR_HIGH:
+        return (" The voltage drive's slope is not refit: the fast model that would judge it is off its own time "
+                "simulation by more than the repeat scatter; the read-out's drive is kept.")
     if v and "slope_rejected" in v:
         r = complex(*v["slope_rejected"])
         return (f" The voltage drive's slope refit with the baseline, A' w_c / A_c = {r.real:.3f}{r.imag:+.3f}i, is "
