@@ -128,7 +128,12 @@ past a coil's, |A' w_c / A_c| > 1, rejected), seed 1:
     cubic_stiffening                     force    seed 1: cubic_stiffening                     high   E  10.53 ->  0.57 ( -95%) floor 0.24 stage 69 s
 
 The neighbour's held-out scores (3.91 force, 3.38 voltage; 8.44 and 15.08 before) stay above the rule's 2 for
-high: not yet understood. Seeds 2-3 of these rows not rerun.
+high: not yet understood. Seeds 2-3 of the neighbour (force, voltage) after, same day:
+
+    neighbour_mode                       force    seed 2: neighbour_mode                       medium E 114.42 ->  1.65 ( -99%) floor 0.18 stage 93 s
+    neighbour_mode                       force    seed 3: neighbour_mode                       medium E 102.72 ->  1.61 ( -98%) floor 0.16
+    neighbour_mode                       voltage  seed 2: neighbour_mode                       medium E  40.26 ->  2.98 ( -93%) floor 0.08 stage 126 s
+    neighbour_mode                       voltage  seed 3: neighbour_mode                       medium E  41.85 ->  3.10 ( -93%) floor 0.08
 """
 import argparse
 import json
