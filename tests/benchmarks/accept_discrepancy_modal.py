@@ -131,9 +131,9 @@ The neighbour's held-out scores (3.91 force, 3.38 voltage; 8.44 and 15.08 before
 high: not yet understood. Seeds 2-3 of the neighbour (force, voltage) after, same day:
 
     neighbour_mode                       force    seed 2: neighbour_mode                       medium E 114.42 ->  1.65 ( -99%) floor 0.18 stage 93 s
-    neighbour_mode                       force    seed 3: neighbour_mode                       medium E 102.72 ->  1.61 ( -98%) floor 0.16
+    neighbour_mode                       force    seed 3: neighbour_mode                       medium E 102.72 ->  1.61 ( -98%) floor 0.16 stage 145 s
     neighbour_mode                       voltage  seed 2: neighbour_mode                       medium E  40.26 ->  2.98 ( -93%) floor 0.08 stage 126 s
-    neighbour_mode                       voltage  seed 3: neighbour_mode                       medium E  41.85 ->  3.10 ( -93%) floor 0.08
+    neighbour_mode                       voltage  seed 3: neighbour_mode                       medium E  41.85 ->  3.10 ( -93%) floor 0.08 stage 176 s
 """
 import argparse
 import json
