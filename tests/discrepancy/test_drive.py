@@ -1,0 +1,139 @@
+"""A voltage drive's slope refit (jointcal.discrepancy.drive.refine_slope) on known truths.
+
+Measured envelopes of the jointed beam (tests/_support/beam_runs.py's mode, its Iwan joint at the truth) driven through
+a known modal constant A(w), with noise at the repeat scatter (0.05 dB, 0.3 deg); the read-out's drive is the truth's
+A_c at w_c with no slope (the read-out's ridge holds it near zero), and the slope is refit.
+
+Oracles: a coil's 1 / (1 + i w tau) has the relative slope A' w_c / A_c = d ln A / d ln w = -i x / (1 + i x) at
+w_c, x = w_c tau, of magnitude x / sqrt(1 + x^2) < 1 at any corner; a drive linear in w has the slope it was given.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from jointcal.calibrate.kind import data_bounds
+from jointcal.calibrate.space import PARAMS, ParamSpace
+from jointcal.discrepancy import drive
+from jointcal.discrepancy.data import RunEnvelope
+from jointcal.discrepancy.drive import refine_slope
+from jointcal.discrepancy.fit import Objective, candidate
+from jointcal.models import G
+from jointcal.validate.drive import gain_at
+from tests._support.beam_runs import BEAM
+
+_b = data_bounds(np.array([3e-3, 3e-2]), np.array([99.0, 97.0]), np.array([0.01, 0.015]), BEAM.m)  # as test_select
+SPACE = ParamSpace(tuple(_b[p][0] for p in PARAMS), tuple(_b[p][1] for p in PARAMS))
+THETA = np.array([BEAM.iwan.Fs, BEAM.iwan.KT, BEAM.iwan.chi, BEAM.iwan.beta, BEAM.k, BEAM.zeta_v])
+C0 = candidate("baseline", SPACE, BEAM.m)
+WC = 2 * np.pi * BEAM.f0_hz  # rad/s
+AC = complex(300.0, -150.0)  # the modal constant at w_c, (in/s^2)/V (tests/_support/beam_runs.py's amplifier)
+LEVELS_V = (0.05, 0.15, 0.45)  # equivalent base 0.04-0.4 g: the joint softens across them
+COIL_BOUND = 1.0  # sup over x of x / sqrt(1 + x^2): the oracle's, not drive.MAX_RELATIVE_SLOPE (under test)
+
+
+def _frames(modal_constant) -> list[RunEnvelope]:
+    """The campaign's frames (0.7-1.3 f0, up and down at each level) driven through modal_constant(f_hz) -> A (complex,
+    (in/s^2)/V): equivalent base -A / G and base amplitude |A| V / G, as `run_envelope` sets them; T not yet measured."""
+    runs = []
+    f = np.linspace(0.7, 1.3, 40) * BEAM.f0_hz
+    eq = -modal_constant(f) / G
+    for level in LEVELS_V:
+        for direction, rate in (("up", 4.0), ("down", -4.0)):
+            row = dict(run_id=f"r{len(runs) + 1}", level_V=level, direction=direction, sequence=len(runs) + 1,
+                       f_res_hz=BEAM.f0_hz, zeta_res=0.01)
+            runs.append(RunEnvelope(f, level * np.abs(eq), np.ones(f.size, complex), np.full(f.size, 0.05),
+                                    np.full(f.size, 0.3), rate, row, level=level, equivalent_base=eq))
+    return runs
+
+
+def _campaign(true_constant, seed: int = 0):
+    """`refine_slope`'s `build` for a campaign measured through the true modal constant (noise at the scatter): each
+    drive's frames with the measured T."""
+    rng = np.random.default_rng(seed)
+    truth = Objective(C0, _frames(true_constant))
+    T = [truth.predict(THETA, i) * 10 ** (rng.normal(0, 0.05, r.f_hz.size) / 20)
+         * np.exp(1j * np.radians(rng.normal(0, 0.3, r.f_hz.size))) for i, r in enumerate(truth.runs)]
+
+    def build(gain):
+        return [replace(r, T=t) for r, t in zip(_frames(lambda f: gain_at(gain, f)), T)]
+    return build
+
+
+def _relative(gain) -> complex:
+    return complex(gain[1] * gain[2] / gain[0])  # A' w_c / A_c
+
+
+READ_OUT = (AC, 0j, WC)  # the read-out's drive: the truth's A_c, no slope
+
+
+@pytest.mark.parametrize("x", [0.094, 1.0, 3.0])  # w_c tau: the beam rig's coil (L/R 0.15 ms at 100 Hz), 1, 3
+def test_a_coils_slope_is_refit_and_kept(x):
+    """Envelopes driven through a coil A_0 / (1 + i w tau) (exact, not linearised): the refit relative slope is the
+    coil's, -i x / (1 + i x), within 10% of its magnitude (the fit is a chord of the curve over 0.7-1.3 w_c), inside
+    the bound, and kept: the gain and runs returned carry it, and the baseline's fast-model E falls."""
+    tau = x / WC
+    a0 = AC * (1 + 1j * x)  # so that A(w_c) = AC
+    build = _campaign(lambda f: a0 / (1 + 1j * 2 * np.pi * f * tau))
+    gain, runs, info = refine_slope(C0, THETA, READ_OUT, build, max_nfev=20)
+    coil = -1j * x / (1 + 1j * x)
+    assert abs(coil) == pytest.approx(x / np.sqrt(1 + x**2)) and abs(coil) < COIL_BOUND
+    got = _relative(gain)
+    print(f"x {x}: coil {coil:.4f}, refit {got:.4f}; E {info['baseline_E_read_out']:.2f} -> "
+          f"{info['baseline_E_refined']:.2f}")
+    assert abs(got - coil) <= 0.1 * abs(coil)
+    assert gain[0] == AC and gain[2] == WC  # A_c and w_c kept (the read-out's resonance fixes them)
+    assert "slope_rejected" not in info
+    assert complex(*info["relative_slope_refined"]) == pytest.approx(got)
+    assert info["baseline_E_refined"] < info["baseline_E_read_out"]
+    f = runs[0].f_hz
+    assert np.allclose(runs[0].equivalent_base, -gain_at(gain, f) / G)
+
+
+@pytest.mark.parametrize("phase", [0.0, np.pi / 2, -2.5])
+@pytest.mark.parametrize("r", [0.7, 1.5])
+def test_a_slope_past_any_coils_is_rejected(r, phase):
+    """A drive linear in w with relative slope r e^{i phase} (the truth): at r = 0.7 (a coil could have it) the refit
+    finds it (within 0.03) and keeps it; at r = 1.5 (no coil could) it finds it too, but the read-out's drive is kept:
+    the gain and runs returned are the read-out's, the E's reported are the read-out's, and the rejected slope is
+    reported (within 10% of r e^{i phase})."""
+    truth = r * np.exp(1j * phase)
+    build = _campaign(lambda f: gain_at((AC, truth * AC / WC, WC), f), seed=1)
+    gain, runs, info = refine_slope(C0, THETA, READ_OUT, build, max_nfev=20)
+    if r < COIL_BOUND:
+        assert abs(_relative(gain) - truth) < 0.03
+        assert "slope_rejected" not in info
+        assert info["baseline_E_refined"] < info["baseline_E_read_out"]
+        return
+    assert gain == READ_OUT
+    assert abs(complex(*info["slope_rejected"]) - truth) < 0.1 * r
+    assert info["slope_refined"] == info["slope_read_out"] == [0.0, 0.0]
+    assert info["baseline_E_refined"] == info["baseline_E_read_out"]
+    for run, kept in zip(runs, build(READ_OUT)):
+        assert np.array_equal(run.equivalent_base, kept.equivalent_base) and np.array_equal(run.T, kept.T)
+
+
+def test_a_slope_that_gains_nothing_is_not_taken(monkeypatch):
+    """Envelopes driven through exactly the read-out's drive (the truth: a coil's slope, -0.09i relative); the slope
+    step is forced to propose a tilt of +0.3 (inside the coil's bound, so only the 'nothing gained' clause can refuse
+    it). The baseline refit with the tilted drive fits worse than with the truth, so the read-out's drive is kept and
+    no slope is reported as rejected (the bound did not refuse it)."""
+    read_out = (AC, -0.09j * AC / WC, WC)
+    build = _campaign(lambda f: gain_at(read_out, f), seed=2)
+    tilt = 0.3 * AC / WC
+    calls = []
+
+    def step(obj, theta, gain):
+        calls.append(gain)
+        return tilt
+    monkeypatch.setattr(drive, "_slope_step", step)
+    gain, runs, info = refine_slope(C0, THETA, read_out, build, max_nfev=20, rounds=1)
+    assert len(calls) == 1 and abs(_relative((AC, read_out[1] + tilt, WC))) < COIL_BOUND
+    tilted = Objective(C0, build((AC, read_out[1] + tilt, WC))).fit(THETA, starts=1, max_nfev=20, refresh=1).E
+    assert tilted > info["baseline_E_read_out"]  # the tilt gains nothing (the truth is the read-out's drive)
+    assert gain == read_out
+    assert info["baseline_E_refined"] == info["baseline_E_read_out"]
+    assert "slope_rejected" not in info
+    assert np.array_equal(runs[0].equivalent_base, build(read_out)[0].equivalent_base)
