@@ -14,22 +14,17 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from jointcal.calibrate.kind import data_bounds
-from jointcal.calibrate.space import PARAMS, ParamSpace
 from jointcal.discrepancy import drive
 from jointcal.discrepancy.data import RunEnvelope
 from jointcal.discrepancy.drive import refine_slope
 from jointcal.discrepancy.fit import Objective, candidate
 from jointcal.models import G
 from jointcal.validate.drive import gain_at
-from tests._support.beam_runs import BEAM
+from tests._support.beam_runs import BEAM, BEAM_JOINT, GAINS, beam_space
 
-_b = data_bounds(np.array([3e-3, 3e-2]), np.array([99.0, 97.0]), np.array([0.01, 0.015]), BEAM.m)  # as test_select
-SPACE = ParamSpace(tuple(_b[p][0] for p in PARAMS), tuple(_b[p][1] for p in PARAMS))
-THETA = np.array([BEAM.iwan.Fs, BEAM.iwan.KT, BEAM.iwan.chi, BEAM.iwan.beta, BEAM.k, BEAM.zeta_v])
-C0 = candidate("baseline", SPACE, BEAM.m)
+C0 = candidate("baseline", beam_space(), BEAM.m)
 WC = 2 * np.pi * BEAM.f0_hz  # rad/s
-AC = complex(300.0, -150.0)  # the modal constant at w_c, (in/s^2)/V (tests/_support/beam_runs.py's amplifier)
+AC = GAINS["voltage"][0]  # the modal constant at w_c, (in/s^2)/V: tests/_support/beam_runs.py's amplifier's
 LEVELS_V = (0.05, 0.15, 0.45)  # equivalent base 0.04-0.4 g: the joint softens across them
 COIL_BOUND = 1.0  # sup over x of x / sqrt(1 + x^2): the oracle's, not drive.MAX_RELATIVE_SLOPE (under test)
 
@@ -54,7 +49,7 @@ def _campaign(true_constant, seed: int = 0):
     drive's frames with the measured T."""
     rng = np.random.default_rng(seed)
     truth = Objective(C0, _frames(true_constant))
-    T = [truth.predict(THETA, i) * 10 ** (rng.normal(0, 0.05, r.f_hz.size) / 20)
+    T = [truth.predict(BEAM_JOINT, i) * 10 ** (rng.normal(0, 0.05, r.f_hz.size) / 20)
          * np.exp(1j * np.radians(rng.normal(0, 0.3, r.f_hz.size))) for i, r in enumerate(truth.runs)]
 
     def build(gain):
@@ -77,7 +72,7 @@ def test_a_coils_slope_is_refit_and_kept(x):
     tau = x / WC
     a0 = AC * (1 + 1j * x)  # so that A(w_c) = AC
     build = _campaign(lambda f: a0 / (1 + 1j * 2 * np.pi * f * tau))
-    gain, runs, info = refine_slope(C0, THETA, READ_OUT, build, max_nfev=20)
+    gain, runs, info = refine_slope(C0, BEAM_JOINT, READ_OUT, build, max_nfev=20)
     coil = -1j * x / (1 + 1j * x)
     assert abs(coil) == pytest.approx(x / np.sqrt(1 + x**2)) and abs(coil) < COIL_BOUND
     got = _relative(gain)
@@ -101,7 +96,7 @@ def test_a_slope_past_any_coils_is_rejected(r, phase):
     reported (within 10% of r e^{i phase})."""
     truth = r * np.exp(1j * phase)
     build = _campaign(lambda f: gain_at((AC, truth * AC / WC, WC), f), seed=1)
-    gain, runs, info = refine_slope(C0, THETA, READ_OUT, build, max_nfev=20)
+    gain, runs, info = refine_slope(C0, BEAM_JOINT, READ_OUT, build, max_nfev=20)
     if r < COIL_BOUND:
         assert abs(_relative(gain) - truth) < 0.03
         assert "slope_rejected" not in info
@@ -129,9 +124,9 @@ def test_a_slope_that_gains_nothing_is_not_taken(monkeypatch):
         calls.append(gain)
         return tilt
     monkeypatch.setattr(drive, "_slope_step", step)
-    gain, runs, info = refine_slope(C0, THETA, read_out, build, max_nfev=20, rounds=1)
+    gain, runs, info = refine_slope(C0, BEAM_JOINT, read_out, build, max_nfev=20, rounds=1)
     assert len(calls) == 1 and abs(_relative((AC, read_out[1] + tilt, WC))) < COIL_BOUND
-    tilted = Objective(C0, build((AC, read_out[1] + tilt, WC))).fit(THETA, starts=1, max_nfev=20, refresh=1).E
+    tilted = Objective(C0, build((AC, read_out[1] + tilt, WC))).fit(BEAM_JOINT, starts=1, max_nfev=20, refresh=1).E
     assert tilted > info["baseline_E_read_out"]  # the tilt gains nothing (the truth is the read-out's drive)
     assert gain == read_out
     assert info["baseline_E_refined"] == info["baseline_E_read_out"]
