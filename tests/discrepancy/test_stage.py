@@ -76,3 +76,137 @@ def test_end_to_end_hidden_gain_is_named_and_the_gap_shrinks(tmp_path):
     assert d["metric_after"] <= 0.3 * d["metric_before"]
     before, after = (np.mean([e[i] for e in err.values()]) for i in (0, 1))
     assert after < 0.5 * before  # the recalibrated joint moves toward the truth
+
+
+# The stage's handling of a voltage drive's slope (`diagnose`, step 0). The rules are control flow inside `diagnose`,
+# between collaborators that each cost seconds to minutes (the library's fits, the GA and posterior, the time
+# simulation): these tests put recording stand-ins for them in `jointcal.discrepancy.stage` and give the stage a
+# known floor and known held-out scores; the oracle is which drive (each stand-in slope refit hands out its own) reaches
+# the recalibration and the time-domain revalidation. The numerics of the refit are tests/discrepancy/test_drive.py's.
+
+READ_OUT_GAIN = (complex(300.0, -150.0), complex(0.0, -0.04), 2 * np.pi * 100.0)  # (A_c, A', w_c) of every run
+
+
+def _voltage_campaign():
+    """A voltage campaign's tables for `diagnose`: four runs of the beam at two levels (V), each with the same
+    swept-mode read-out, so `drive_gain` gives READ_OUT_GAIN; the calibration's ga_best at the beam's truth."""
+    from tests._support.beam_runs import BEAM, BEAM_JOINT
+
+    ac, da, wc = READ_OUT_GAIN
+    rows = [{"run_id": f"r{i}", "assembly": "beam", "level_V": lev, "direction": d, "sequence": i}
+            for i, (lev, d) in enumerate([(0.1, "up"), (0.1, "down"), (0.4, "up"), (0.4, "down")], start=1)]
+    modal = pd.DataFrame([{**r, "f_res_hz": wc / (2 * np.pi), "zeta_res": 0.01, "q_in": 1e-3 * r["level_V"],
+                           "modal_constant_re": ac.real, "modal_constant_im": ac.imag, "modal_slope_re": da.real,
+                           "modal_slope_im": da.imag} for r in rows])
+    best = {**dict(zip(PARAMS, map(float, BEAM_JOINT))), "m": BEAM.m, "model_kind": "modal"}
+    return rows, modal, best
+
+
+def _stand_ins(monkeypatch, floor: float, scores: dict[str, float]) -> dict:
+    """Recording stand-ins in the stage for everything but its drive logic and `rule.decide`: the floor E `floor`,
+    the library scored at `scores` (name -> held-out score, whatever the drive), the n-th slope refit handing out
+    its own drive (READ_OUT_GAIN's slope + n x 0.01i); returns what they saw."""
+    from types import SimpleNamespace
+
+    from jointcal.discrepancy import stage
+    from jointcal.discrepancy.fit import Fit, candidate
+    from jointcal.discrepancy.select import Scored
+
+    seen = {"refits": [], "recalibrated_runs": None, "revalidated_rows": None}
+
+    def usable_runs(assembly, envs, mrows, rows, *args):  # a run per row, tagged with the drive it was built with
+        return [SimpleNamespace(f_hz=np.zeros(3), row=r, gain=r["drive_gain"]) for r in rows]
+
+    def refine_slope(c0, theta0, gain, build, *, max_nfev):
+        ac, da, wc = gain
+        new = (ac, READ_OUT_GAIN[1] + 0.01j * (len(seen["refits"]) + 1), wc)
+        seen["refits"].append((c0.name, gain, new))
+        rel = lambda g: [float((g[1] * g[2] / g[0]).real), float((g[1] * g[2] / g[0]).imag)]  # noqa: E731
+        info = {"relative_slope_read_out": rel(gain), "relative_slope_refined": rel(new), "baseline_E_read_out": 2.0,
+                "baseline_E_refined": 1.0}
+        return new, build(new), info
+
+    def score_library(assembly, space, m, runs, theta0, F, settings, joint_starts, clock, say, scales):
+        out = []
+        for name, score in scores.items():
+            c = candidate(name, space, m, scales)
+            th = c.grown.vector(dict(zip(PARAMS, theta0)), default={p.name: p.start for p in c.effect_params})
+            out.append(Scored(name, Fit(name, th, score, 1e-4 * np.eye(c.grown.ndim), 1), score))
+        return out, []
+
+    def recalibrated(assembly, final, space, m, runs, *args):
+        seen["recalibrated_runs"] = runs
+        return final, candidate(final.name, space, m, None), None, 1
+
+    def validate_runs(models, records, rows, **kw):
+        seen["revalidated_rows"] = rows
+        return SimpleNamespace(error={"E": 1.0}, words="", frames={}, metrics=pd.DataFrame())
+
+    fp = {"h2_ratio": 0.0, "h3_ratio": 0.0}
+    ver = {n: {"for": [], "against": []} for n in scores}
+    for name, fn in {"_usable_runs": usable_runs, "refine_slope": refine_slope, "_score_library": score_library,
+                     "_recalibrated": recalibrated, "validate_runs": validate_runs,
+                     "fast_floor": lambda *a: {"E": floor, "per_level": {}},
+                     "_localise": lambda *a: (pd.DataFrame(), fp, ver, None),
+                     "_recalibrated_json": lambda *a: {}}.items():
+        monkeypatch.setattr(stage, name, fn)
+    return seen
+
+
+def _diagnose_voltage(monkeypatch, floor, scores):
+    """`diagnose` of the voltage campaign with the stand-ins: the diagnosis, what the stand-ins saw, the log."""
+    from jointcal.discrepancy.stage import diagnose
+    from tests._support.beam_runs import beam_space
+
+    seen = _stand_ins(monkeypatch, floor, scores)
+    rows, modal, best = _voltage_campaign()
+    said = []
+    d = diagnose("beam", {}, modal, best, [], [], rows, space=beam_space(),
+                 settings=DiscrepancySettings(candidates=("cubic_stiffening",)), metric_before=1.2,
+                 frames_before={}, log=said.append)["diagnosis"]
+    return d, seen, said
+
+
+@pytest.mark.parametrize("floor", [2.0, 30.0])  # above the repeat scatter (E 1); 30: the real UNESP beam's
+def test_a_voltage_drives_slope_is_not_refit_above_the_repeat_scatter(monkeypatch, floor):
+    """Where the fast model's floor is above the repeat scatter (E > 1), no slope is refit: the read-out's drive is
+    what every step takes (the recalibration's runs, the time-domain revalidation's rows), diagnosis.json has no
+    voltage_drive, and the log says why."""
+    d, seen, said = _diagnose_voltage(monkeypatch, floor, {"baseline": 1.2, "cubic_stiffening": 1.1})
+    assert seen["refits"] == []
+    assert d["voltage_drive"] is None
+    assert all(r.gain == READ_OUT_GAIN for r in seen["recalibrated_runs"])
+    assert all(r["drive_gain"] == READ_OUT_GAIN for r in seen["revalidated_rows"])
+    assert any("slope not refit" in s and f"E {floor:.2f}" in s for s in said)
+
+
+def test_a_voltage_drives_slope_is_refit_below_the_repeat_scatter(monkeypatch):
+    """The other side of the same clause (floor E 0.5, below the scatter): the baseline refits the slope from the
+    read-out's drive, and a name (cubic_stiffening, which scores 0.9 against the baseline's 6) refits it again from
+    the baseline's; the named model's drive is the one recalibrated and revalidated."""
+    d, seen, said = _diagnose_voltage(monkeypatch, 0.5, {"baseline": 6.0, "cubic_stiffening": 0.9})
+    assert d["effect"] == "cubic_stiffening"
+    assert [(name, gain) for name, gain, _ in seen["refits"]] == [
+        ("baseline", READ_OUT_GAIN), ("cubic_stiffening", seen["refits"][0][2]),  # the lead's, over the baseline's
+        ("cubic_stiffening", seen["refits"][1][2])]  # the named model's, over the lead's
+    named = seen["refits"][2][2]
+    assert all(r.gain == named for r in seen["recalibrated_runs"])
+    assert all(r["drive_gain"] == named for r in seen["revalidated_rows"])
+    assert not any("slope not refit" in s for s in said)
+
+
+@pytest.mark.parametrize("scores, effect", [({"baseline": 1.2, "cubic_stiffening": 1.1}, "none"),
+                                            ({"baseline": 10.0, "cubic_stiffening": 8.0}, "unexplained")])
+def test_where_nothing_is_named_the_baseline_is_revalidated_with_its_own_drive(monkeypatch, scores, effect):
+    """A candidate scores better than the baseline (so the slope is refit with it and the library scored again), but
+    the rule names nothing ('none': the baseline is within the scatter; 'unexplained': the candidate closes too little
+    of the gap). The baseline is then recalibrated and revalidated with the drive it refit itself, not the one the
+    better-scoring candidate refit, and diagnosis.json says so."""
+    d, seen, _ = _diagnose_voltage(monkeypatch, 0.5, scores)
+    assert d["effect"] == effect and d["recalibrated"] == {}
+    assert [name for name, *_ in seen["refits"]] == ["baseline", "cubic_stiffening"]
+    own, lead = seen["refits"][0][2], seen["refits"][1][2]
+    assert own != lead
+    assert all(r.gain == own for r in seen["recalibrated_runs"])
+    assert all(r["drive_gain"] == own for r in seen["revalidated_rows"])
+    assert d["voltage_drive"]["revalidated_with"] == "the baseline's slope"
