@@ -45,3 +45,19 @@ def test_the_words_never_contradict_the_verdict():
     worse = diagnosis_markdown(_diagnosis("sensor_gain", 6.0, 6.5, 7.0, 0.14, [("sensor_gain", 1.9)],
                                           confidence="low", note="name_not_confirmed"))
     assert "does not fall" in worse and "does not confirm" in worse and "(confidence low)" in worse
+
+
+def test_the_words_say_when_and_why_a_voltage_drives_slope_is_not_taken():
+    """The floor's sentence says the slope is not refit exactly where the stage did not refit it (a voltage drive, no
+    refit, floor above the repeat scatter E 1), and says a rejected slope is past any coil's (|A' w_c / A_c| 1)."""
+    def words(unit, floor, drive=None):
+        d = _diagnosis("none", 0.37, 0.2, 1.1, floor, [("sensor_gain", 1.1)])
+        return diagnosis_markdown({**d, "level_unit": unit, "voltage_drive": drive})
+
+    not_refit = "slope is not refit"
+    assert not_refit in words("V", 2.0) and "read-out's drive is kept" in words("V", 2.0)
+    assert not_refit not in words("V", 0.5)  # below the scatter the stage refits it
+    assert not_refit not in words("lbf", 2.0)  # a force's drive is never refit: nothing to say
+    rejected = {"slope_read_out": [0.0, 0.0], "slope_refined": [0.0, 0.0], "slope_rejected": [-6.6, 1.3]}
+    said = words("V", 0.5, rejected)
+    assert "-6.600+1.300i" in said and "past any coil's (magnitude 1)" in said and not_refit not in said
