@@ -132,3 +132,11 @@ def test_a_slope_that_gains_nothing_is_not_taken(monkeypatch):
     assert info["baseline_E_refined"] == info["baseline_E_read_out"]
     assert "slope_rejected" not in info
     assert np.array_equal(runs[0].equivalent_base, build(read_out)[0].equivalent_base)
+
+
+def test_the_slope_is_refit_only_for_a_voltage_drive_whose_fast_model_is_within_the_scatter():
+    """The clause `refits_slope` states (the stage and the words ask it): a voltage campaign, and a fast-model floor
+    at most the repeat scatter (E 1); an unmeasured floor counts as 0; a force or base drive never."""
+    assert drive.refits_slope("V", 0.5) and drive.refits_slope("V", 1.0) and drive.refits_slope("V", None)
+    assert not drive.refits_slope("V", 1.01) and not drive.refits_slope("V", 30.0)
+    assert not drive.refits_slope("lbf", 0.1) and not drive.refits_slope("g", 0.1)

@@ -2,7 +2,7 @@
 import pandas as pd
 import pytest
 
-from jointcal.io import excitation_kind, level_column
+from jointcal.io import excitation_kind, level_column, level_unit
 
 
 @pytest.mark.parametrize("names, kind", [
@@ -24,4 +24,6 @@ def test_level_column_and_no_default():
     assert level_column(["run_id", "level_V"]) == "level_V"
     assert level_column(pd.DataFrame(columns=["level_lbf", "q_in"]).columns) == "level_lbf"
     assert level_column(["run_id"]) is None
+    assert [level_unit(["q_in", c]) for c in ("level_g", "level_lbf", "level_V")] == ["g", "lbf", "V"]
+    assert level_unit({"run_id": "a"}) == ""  # a row's keys, no level
     assert excitation_kind(["run_id"], None) is None

@@ -37,7 +37,7 @@ import pandas as pd
 
 from ..calibrate.space import PARAMS, ParamSpace
 from ..effects import EFFECTS, effects_of
-from ..io import excitation_kind, level_column, run_test_kind
+from ..io import excitation_kind, level_unit, run_test_kind
 from ..measure.testkinds.read import read_test_run
 from ..validate import ValidateSettings, model_from_best, validate_runs
 from ..validate.decay import PART as DECAY
@@ -263,7 +263,7 @@ def diagnose_decays(assembly: str, backbone: pd.DataFrame, modal: pd.DataFrame, 
     after = cf.grown.named(rec.fit.theta)
     diagnosis = {
         "assembly": assembly, "model_kind": kind, "structure_scales": scales, "data": "decays",
-        "level_unit": (level_column(modal.columns) or "_").split("_", 1)[1],
+        "level_unit": level_unit(modal.columns),
         "effect": effect, "effects": list(effects_of(effect)) if effect not in ("none", "unexplained") else [],
         "confidence": confidence, "rule": decision.rule,
         "rule_applied": [*decision.applied, *([CLAUSES[note]] if note else [])], "outside_library": None,

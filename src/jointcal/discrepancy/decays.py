@@ -39,7 +39,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from ..io import level_column
+from ..io import level_column, level_unit
 from ..io.contract import UNUSABLE
 from ..io.testkinds import run_test_kind
 from ..measure.testkinds import level_readout
@@ -203,7 +203,7 @@ def decay_folds(runs: Sequence[DecayRun]) -> dict[str, list[int]]:
     """Held-out folds: each level's runs, and each amplitude band across the runs ({} with one run)."""
     if len({r.run_id for r in runs}) < 2:
         return {}
-    unit = (level_column(runs[0].row) or "_").split("_", 1)[1]
+    unit = level_unit(runs[0].row)
     levels = [r.level for r in runs]
     folds = {f"{L:g} {unit}".strip(): [i for i, v in enumerate(levels) if v == L] for L in sorted(set(levels))}
     if len(folds) < 2:

@@ -28,6 +28,10 @@ the baseline has bent the drive to an effect it misses (on the jointed beam with
 -6.6 + 1.3i, and the neighbour then scored 15 where the read-out's drive leaves it the best), so the read-out's
 drive is kept and the slope reported as rejected.
 
+The slope is refit only where the fast model is within the repeat scatter of its own time simulation
+(`refits_slope`: the floor E at most `rule.FLOOR_HIGH`); above it, the fast model that would judge the
+slope is further from its record than the slope moves it (the real UNESP beam: floor 30).
+
 A force at the driving point is 1/m by physics (real, no slope, `jointcal.measure.sweepfit`):
 its drive is left as the read-out gives it.
 """
@@ -40,12 +44,19 @@ from numpy.typing import NDArray
 
 from .data import RunEnvelope
 from .fit import Candidate, Fit, Objective
+from .rule import FLOOR_HIGH
 
-__all__ = ["ROUNDS", "MAX_RELATIVE_SLOPE", "refine_slope"]
+__all__ = ["ROUNDS", "MAX_RELATIVE_SLOPE", "refits_slope", "refine_slope"]
 
 ROUNDS = 4  # turns of (joint fit, slope) at most; they stop earlier once the slope moves < 2% of itself
 MAX_RELATIVE_SLOPE = 1.0  # |A' w_c / A_c| of a coil's 1 / (1 + i w tau) is x / sqrt(1 + x^2) < 1, x = w_c tau
 Gain = tuple[complex, complex, float]
+
+
+def refits_slope(level_unit: str, floor: float | None) -> bool:
+    """Whether the stage refits the drive's slope (`refine_slope`): a voltage drive (level unit 'V') whose fast
+    model's floor E (None: not measured, taken as 0) is at most `rule.FLOOR_HIGH`, the repeat scatter."""
+    return level_unit == "V" and (floor is None or floor <= FLOOR_HIGH)
 
 
 def _slope_step(obj: Objective, theta: NDArray, gain: Gain) -> complex:

@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .data import RunEnvelope
-from ..io import level_column
+from ..io import level_unit
 from .fit import Candidate, Fit, Objective
 
 __all__ = ["PENALTY_PER_PARAM", "Scored", "score_candidates"]
@@ -64,7 +64,7 @@ def _folds(runs: Sequence[RunEnvelope]) -> dict[str, list[int]]:
     an unseen one no better); directions interleave in the run sequence (up, down, up, ...),
     so a drift with the sequence is judged on runs between fitted ones, and a sweep effect on
     the branch it was not fitted on."""
-    unit = (level_column(runs[0].row) or "_").split("_", 1)[1]  # the level's unit: g, lbf or V
+    unit = level_unit(runs[0].row)
     levels = [r.level for r in runs]
     folds = {f"{L:g} {unit}".strip(): [i for i, v in enumerate(levels) if v == L] for L in sorted(set(levels))}
     if len(folds) < 2:

@@ -41,7 +41,7 @@ import pandas as pd
 from ..calibrate.space import PARAMS, ParamSpace
 from ..effects import EFFECTS, effects_of
 from ..calibrate.kind import backbone_at
-from ..io import level_column, run_test_kind
+from ..io import level_column, level_unit, run_test_kind
 from ..io.contract import LEVEL
 from ..validate.drive import drive_gain
 from ..validate.testkinds import as_read
@@ -50,12 +50,12 @@ from ..posterior.sampler import TAU_FACTOR
 from ..validate import ValidateSettings, model_from_best, validate_runs
 from .data import run_envelope, scale_arrays
 from .decay_stage import diagnose_decays
-from .drive import refine_slope
+from .drive import refine_slope, refits_slope
 from .fingerprints import fingerprints, outside_library, residual_map, verdicts
 from .fit import Objective, candidate, model_at, structure_scales
 from .floor import fast_floor
 from .recalibrate import recalibrate
-from .rule import CLAUSES, FLOOR_HIGH, confirm, decide, needs_pairs, pair_bases, pair_names
+from .rule import CLAUSES, confirm, decide, needs_pairs, pair_bases, pair_names
 from .settings import DiscrepancySettings
 from .select import score_candidates
 from .words import diagnosis_markdown
@@ -168,11 +168,11 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     say(f"{assembly}: the fast model's floor (its envelope of the calibrated model against the time simulation) "
         f"E = {F:.2f}" + ("" if floor["E"] is not None else " (no validation frames to compare: taken as 0)"))
     clock.lap("floor")
-    drive = None
-    if gain is not None and level_column(modal.columns) == LEVEL["voltage"] and F > FLOOR_HIGH:
+    drive, unit = None, level_unit(modal.columns)
+    if gain is not None and unit == "V" and not refits_slope(unit, F):
         say(f"{assembly}: the voltage drive's slope not refit: the fast model that would judge it is off its own "
             f"time simulation by E {F:.2f}, more than the repeat scatter")
-    elif gain is not None and level_column(modal.columns) == LEVEL["voltage"]:  # the coil's slope (`drive`)
+    elif gain is not None and refits_slope(unit, F):  # the coil's slope (`drive`)
         def build(g):
             return _usable_runs(assembly, envs, mrows, [{**r, "drive_gain": g} for r in rows], sdb, sdeg, settings,
                                 zeta_min)
@@ -224,7 +224,7 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     clock.lap("validate_after")
     effect, confidence, time_note = confirm(effect, confidence, float(metric_before), metric_after)
     diagnosis = {
-        "assembly": assembly, "model_kind": kind, "structure_scales": scales, "level_unit": (level_column(modal.columns) or "_").split("_", 1)[1],
+        "assembly": assembly, "model_kind": kind, "structure_scales": scales, "level_unit": unit,
         "effect": effect, "effects": list(effects_of(effect)) if effect not in (
             "none", "unexplained") else [], "confidence": confidence, "rule": decision.rule,
         "rule_applied": [*decision.applied, *([CLAUSES[time_note]] if time_note else [])],

@@ -20,7 +20,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from ..effects import EFFECTS
-from .drive import MAX_RELATIVE_SLOPE
+from .drive import MAX_RELATIVE_SLOPE, refits_slope
 from .rule import FLOOR_HIGH, NONE_E
 
 __all__ = ["diagnosis_markdown"]
@@ -48,7 +48,7 @@ def _drive(d: Mapping) -> str:
     """A voltage drive's slope refit (`drive.refine_slope`), in a sentence ('' when none was)."""
     v = d.get("voltage_drive")
     fl = (d.get("fast_model_floor") or {}).get("E")
-    if v is None and d.get("level_unit") == "V" and fl is not None and fl > FLOOR_HIGH:
+    if v is None and d.get("level_unit") == "V" and not refits_slope("V", fl):
         return (" The voltage drive's slope is not refit: the fast model that would judge it is off its own time "
                 "simulation by more than the repeat scatter; the read-out's drive is kept.")
     if v and "slope_rejected" in v:

@@ -34,7 +34,7 @@ Modules, in the order a record flows through them:
 """
 from __future__ import annotations
 
-from jointcal.io.contract import CampaignError, CampaignWarning, excitation_kind, level_column
+from jointcal.io.contract import CampaignError, CampaignWarning, excitation_kind, level_column, level_unit
 from jointcal.io._atomic import write_bytes_atomic, write_csv_atomic, write_json_atomic, write_run
 from jointcal.io._checks import UNUSABLE_FLAGS, validate_run
 from jointcal.io.testkinds import run_test_kind, test_kind
@@ -42,7 +42,7 @@ from jointcal.io._manifest import read_manifest
 from jointcal.io._records import ingest_campaign, listed_record, read_run
 
 __all__ = [
-    "CampaignError", "CampaignWarning", "excitation_kind", "level_column", "read_manifest", "read_run",
+    "CampaignError", "CampaignWarning", "excitation_kind", "level_column", "level_unit", "read_manifest", "read_run",
     "validate_run", "ingest_campaign", "listed_record", "write_bytes_atomic", "write_csv_atomic",
     "write_json_atomic", "write_run", "UNUSABLE_FLAGS", "test_kind", "run_test_kind",
 ]

@@ -2,7 +2,7 @@
 
 Public: the stages after ingest read a record's and a table's columns by these names
 (`REFERENCE`, `RESPONSE`, `LEVEL`, ...) and raise with `fail`. `jointcal.io` re-exports
-`CampaignError`, `CampaignWarning`, `excitation_kind` and `level_column`.
+`CampaignError`, `CampaignWarning`, `excitation_kind`, `level_column` and `level_unit`.
 """
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from jointcal.units import FOOT_IN, G, G_SI, INCH_M, LBF_N
 
 __all__ = ["Excitation", "OnDataProblem", "TIME", "RESPONSE", "REFERENCE", "LEVEL", "RESPONSE_SI", "TEXT", "START", "REF_FILE",
            "CHANNEL_COLUMNS", "POSITIVE", "QUANTITY", "UNITS", "SI_UNIT", "FS_RTOL", "MIN_CYCLES", "CampaignError",
-           "CampaignWarning", "fail", "excitation_kind", "level_column", "excitation_of", "UNUSABLE"]
+           "CampaignWarning", "fail", "excitation_kind", "level_column", "level_unit", "excitation_of", "UNUSABLE"]
 
 Excitation = Literal["base", "force", "voltage"]
 OnDataProblem = Literal["error", "flag"]
@@ -96,6 +96,11 @@ def level_column(names: Iterable[object]) -> str | None:
     """The level column among `names` (``level_g``, ``level_lbf`` or ``level_V``, in that order); None if none."""
     names = {str(n) for n in names}
     return next((c for c in LEVEL.values() if c in names), None)
+
+
+def level_unit(names: Iterable[object]) -> str:
+    """The unit of the level column among `names` ('g', 'lbf' or 'V', `level_column`); '' if there is none."""
+    return (level_column(names) or "_").split("_", 1)[1]
 
 
 def excitation_of(names: Sequence[str], where: object, *, expected: Excitation | None = None,
