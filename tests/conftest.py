@@ -14,6 +14,9 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
 import shutil  # noqa: E402
+import tempfile  # noqa: E402
+import threading  # noqa: E402
+import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import pandas as pd  # noqa: E402
@@ -28,15 +31,55 @@ from tests._support.modal_helpers import modal_table  # noqa: E402
 
 
 def pytest_configure(config: pytest.Config) -> None:
-    """Compile the numba kernels into numba's cache once, here, before the xdist workers start (a worker inherits
-    nothing but the cache). On a fresh clone the cache is empty, and each worker, and each Snakemake job a test
-    starts, compiled the kernels it called for itself: one discrepancy test took 62 s of CPU cold, 26 s warm.
-    A warm cache makes this a 2 s load; the workers then load the kernels too."""
-    if hasattr(config, "workerinput"):  # an xdist worker: the controller has compiled them
+    """Compile the numba kernels into numba's cache once, here in the controller (a worker inherits nothing but the
+    cache). On a fresh clone the cache is empty, and each worker, and each Snakemake job a test starts, compiled the
+    kernels it called for itself: one discrepancy test took 62 s of CPU cold, 26 s warm. A warm cache makes this a
+    2 s load; the workers then load the kernels too.
+
+    With xdist the compilation runs in a thread while the workers start and collect (each takes about 6 s of its
+    own: imports and collection), and each worker waits for it before its first test (`pytest_runtestloop`), so the
+    compilation no longer precedes the workers' start: on a fresh clone it took 15-30 s of wall time with the other
+    core idle. Without workers it runs here, before the tests, as before."""
+    if hasattr(config, "workerinput"):  # an xdist worker: the controller compiles them
         return
     from jointcal.models.kernels import compile_kernels
 
-    compile_kernels()
+    if not (getattr(config.option, "numprocesses", None) and getattr(config.option, "dist", "no") != "no"):
+        compile_kernels()
+        return
+    done = Path(tempfile.mkdtemp(prefix="jointcal-kernels-")) / "compiled"
+    os.environ[KERNELS_DONE] = str(done)  # the workers, started after this hook, inherit the environment
+
+    def compile_then_say_so() -> None:
+        try:
+            compile_kernels()
+        finally:  # a failure too: the workers then compile what they call, as without this
+            done.write_text("compiled\n")
+
+    threading.Thread(target=compile_then_say_so, name="compile_kernels", daemon=True).start()
+
+
+KERNELS_DONE = "JOINTCAL_TESTS_KERNELS_COMPILED"  # the file the controller writes once the kernels are in the cache
+KERNELS_WAIT_S = 900.0  # s: a bound on the wait (a cold compilation takes 15-30 s)
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_runtestloop(session: pytest.Session) -> None:
+    """An xdist worker, collected, waits for the controller's compilation (`pytest_configure`) before its first
+    test; it then loads the kernels from numba's cache. Returns None: the test loop then runs as usual."""
+    done = os.environ.get(KERNELS_DONE)
+    if not done or not hasattr(session.config, "workerinput"):
+        return
+    deadline = time.monotonic() + KERNELS_WAIT_S
+    while not Path(done).exists() and time.monotonic() < deadline:
+        time.sleep(0.05)
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    """The controller removes the folder of its compilation's file (`pytest_configure`)."""
+    done = os.environ.get(KERNELS_DONE)
+    if done and not hasattr(config, "workerinput"):
+        shutil.rmtree(Path(done).parent, ignore_errors=True)
 
 
 @pytest.fixture(scope="session")
