@@ -11,9 +11,9 @@ frame's time, drive frequency and base amplitude, and the envelopes' window leng
 its magnitude and its phase against the sweep (`SweepDrive.phase_rad`), over every frame from
 the run's first to its last (the open-loop force's dip at resonance included).
 
-A frame whose window reaches past the sweep's commanded ends (f_start, f_stop, the frame's drive
-frequency +- |rate| L / 2 for a window of L s) is not used (`within_sweep`): it averages the drive's
-start or stop, a ringing response over a vanishing reference. The base rig's full-drive fraction (0.8)
+A frame whose window (its time +- L / 2) reaches past the sweep's commanded span (from f_start to f_stop
+at the manifest's rate, placed in time by the drive-on frames) is not used (`within_sweep`): it averages
+the drive's start or stop, a ringing response over a vanishing reference. The base rig's full-drive fraction (0.8)
 leaves most of them out; an open-loop force's (0.05, for its dip at resonance) kept the last frame of
 every run. On the jointed beam with a neighbouring mode hidden (force rig, seed 1), that frame alone
 (128.17 Hz, the drive at 37% of full) was off its own time simulation by 2.8 dB and 24 deg in the fast
@@ -114,21 +114,27 @@ def _window_s(row: Mapping, zeta_min: float) -> float | None:
     return window_length(fs, rate, f_low, zeta_min=zeta_min) / fs
 
 
-def within_sweep(f_hz: NDArray, row: Mapping, window_s: float | None) -> NDArray[np.bool_]:
-    """Frames whose envelope window lies within the sweep's commanded span: f -+ |rate| L / 2 inside
-    [f_start, f_stop] (all True when the row lacks the sweep or the window is unknown).
+def within_sweep(t_s: NDArray, f_hz: NDArray, on: NDArray, row: Mapping, window_s: float | None) -> NDArray[np.bool_]:
+    """Frames whose envelope window (t -+ L / 2) lies within the sweep's commanded span (all True when the
+    row lacks the sweep or the window is unknown).
 
-    A frame reaching past either end averages the drive's start or stop ramp: a response ringing on over
-    a reference that vanishes within the window, which no steady or first-order envelope follows."""
-    f = np.asarray(f_hz, dtype=float)
+    The span is [t0, t0 + |f_stop - f_start| / rate], t0 the median over the drive-on frames of where the
+    manifest's sweep line through each frame's (t, f) starts: the frames' own drive frequency bends near the
+    ends (the ridge: +-0.15-0.3 Hz on the beam's eta-2 runs), so a frame is placed in time, not by its
+    frequency. A frame reaching past either end averages the drive's start or stop: a response ringing on
+    over a reference that vanishes within the window, which no steady or first-order envelope follows."""
+    t, f = np.asarray(t_s, dtype=float), np.asarray(f_hz, dtype=float)
+    keep = np.ones(t.shape, bool)
     try:
-        lo, hi = sorted((float(row["f_start_hz"]), float(row["f_stop_hz"])))
-        half = abs(float(row["sweep_rate_hz_per_s"])) * float(window_s) / 2
+        f0, f1, rate, L = (float(row["f_start_hz"]), float(row["f_stop_hz"]), abs(float(row["sweep_rate_hz_per_s"])),
+                           float(window_s))
     except (KeyError, TypeError, ValueError):
-        return np.ones(f.shape, bool)
-    if not (np.isfinite(lo) and np.isfinite(hi) and np.isfinite(half)):
-        return np.ones(f.shape, bool)
-    return (f - half >= lo) & (f + half <= hi)
+        return keep
+    on = np.asarray(on, bool) & np.isfinite(t) & np.isfinite(f)
+    if not (np.isfinite([f0, f1, rate, L]).all() and rate > 0 and f1 != f0 and on.any()):
+        return keep
+    t0 = float(np.median(t[on] - (f[on] - f0) / (np.sign(f1 - f0) * rate)))
+    return (t - L / 2 >= t0) & (t + L / 2 <= t0 + abs(f1 - f0) / rate)
 
 
 def run_envelope(env: pd.DataFrame, row: Mapping, sigma_db: NDArray, sigma_deg: NDArray, *,
@@ -164,7 +170,7 @@ def run_envelope(env: pd.DataFrame, row: Mapping, sigma_db: NDArray, sigma_deg: 
     ok = full_drive(env, full_drive_fraction(row))
     ok &= (f >= band[0] * f_res) & (f <= band[1] * f_res)
     L = _window_s(row, zeta_min)
-    ok &= within_sweep(f, row, L)
+    ok &= within_sweep(env["time_s"].to_numpy(float), f, env["drive_on"].to_numpy(bool), row, L)
     idx = np.flatnonzero(ok)
     if idx.size < MIN_FRAMES:
         return None
