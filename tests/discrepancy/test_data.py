@@ -43,3 +43,10 @@ def test_a_down_sweep_and_a_row_without_its_sweep():
     keep = within_sweep(t, f, on, row, L)
     assert np.array_equal(keep, (t - L / 2 >= 0.1) & (t + L / 2 <= 20.1))
     assert within_sweep(t, f, on, {}, L).all() and within_sweep(t, f, on, ROW, None).all()
+
+
+def test_frames_off_the_manifests_line_are_all_kept():
+    """A sweep the manifest does not describe (here logarithmic over the same ends): no frame is placed by it."""
+    t, _, on = _frames()
+    f = 70.0 * (130.0 / 70.0) ** np.clip((t - 0.1) / 20.0, 0, 1)
+    assert within_sweep(t, f, on, ROW, L).all()

@@ -122,7 +122,9 @@ def within_sweep(t_s: NDArray, f_hz: NDArray, on: NDArray, row: Mapping, window_
     manifest's sweep line through each frame's (t, f) starts: the frames' own drive frequency bends near the
     ends (the ridge: +-0.15-0.3 Hz on the beam's eta-2 runs), so a frame is placed in time, not by its
     frequency. A frame reaching past either end averages the drive's start or stop: a response ringing on
-    over a reference that vanishes within the window, which no steady or first-order envelope follows."""
+    over a reference that vanishes within the window, which no steady or first-order envelope follows. Frames
+    that do not follow the manifest's linear sweep (their median distance from its line above a window's
+    sweep, |rate| L) cannot be placed so: all are kept."""
     t, f = np.asarray(t_s, dtype=float), np.asarray(f_hz, dtype=float)
     keep = np.ones(t.shape, bool)
     try:
@@ -134,6 +136,9 @@ def within_sweep(t_s: NDArray, f_hz: NDArray, on: NDArray, row: Mapping, window_
     if not (np.isfinite([f0, f1, rate, L]).all() and rate > 0 and f1 != f0 and on.any()):
         return keep
     t0 = float(np.median(t[on] - (f[on] - f0) / (np.sign(f1 - f0) * rate)))
+    line = f0 + np.sign(f1 - f0) * rate * (t - t0)
+    if np.median(np.abs(f[on] - line[on])) > rate * L:  # the frames do not follow the manifest's linear sweep
+        return keep
     return (t - L / 2 >= t0) & (t + L / 2 <= t0 + abs(f1 - f0) / rate)
 
 
