@@ -42,3 +42,32 @@ def test_E_of_the_truth_is_about_one_on_noise_at_the_scatter():
     runs = _runs()
     E = Objective(candidate("baseline", SPACE, M), runs).E(TRUTH)
     assert 0.8 < E < 1.2  # noise of exactly the scatter: E = 1 within its sampling spread (1280 frames)
+
+
+def test_a_refreshing_fit_tries_its_effect_starts_and_grid(monkeypatch):
+    """A fit with refresh (every stage fit) starts the effect values theta0 leaves out from their start, spread
+    points and the best point of their grid (`EffectParam.grid`), and refits from its optimum alone; the grid's
+    best point is one batched evaluation. (The refreshing path once passed the completed vector on: the start
+    value alone was tried.)"""
+    from dataclasses import replace as dc_replace
+    from jointcal.discrepancy import fit as fit_module
+    from jointcal.effects import Effect, EffectParam
+    new = Effect("base_gain", (EffectParam("b", "-", 0.5, 2.0, True, 1.0, "base channel reading / true", grid=9),),
+                 lambda m, v, row: dc_replace(m, sensor_gain=m.sensor_gain / v["b"]), lambda v: "check the base")
+    monkeypatch.setitem(EFFECTS, "base_gain", new)
+    c = candidate("base_gain", SPACE, M)
+    runs = _runs("base_gain", [0.6])
+    x0s = []
+    real = fit_module.least_squares
+
+    def spy(fun, x0, **kw):
+        x0s.append(np.array(x0, float))
+        return real(fun, x0, **kw)
+
+    monkeypatch.setattr(fit_module, "least_squares", spy)
+    f = Objective(c, runs).fit(TRUTH, starts=3, max_nfev=15, refresh=1)
+    b0 = [x[-1] for x in x0s]
+    # the first fit: the start (b = 1, u 0.5), the spread points (u 0.15, 0.85), the grid's best (u = 1/8: b 0.6
+    # is u 0.132); then the refit from its optimum
+    assert len(x0s) == 5 and np.allclose(b0[:3], [0.5, 0.15, 0.85], atol=1e-5)
+    assert abs(b0[3] - 0.125) < 1e-3 and abs(f.theta[6] / 0.6 - 1) < 0.03

@@ -253,17 +253,35 @@ class Objective:
 def refreshed_fit(obj, theta0: NDArray, starts: int, max_nfev: int, free_joint: bool, refresh: int) -> Fit:
     """An objective's fit (`Objective.fit`, `decays.DecayObjective.fit`): theta0 completed with the effects' start
     values, then `least_squares_fit` at the objective's factors, or, with refresh, at the factors retaken at the
-    start (``obj.at``) and again at each optimum, refitting from it."""
+    start (``obj.at``) and again at each optimum, refitting from it (from the optimum alone).
+
+    The first fit is told which effect values theta0 gave: the others are also started from spread points
+    and their grids (`least_squares_fit`). (Until 2026-11-26 the refreshing path passed the completed vector
+    on, so a fit with refresh tried the effect's start value alone, whatever `starts` said.)"""
     space = obj.candidate.grown
     given = dict(zip(space.names, map(float, theta0)))  # the space's leading columns
     th0 = space.vector(given, default={p.name: p.start for p in obj.candidate.effect_params})
-    if refresh:
-        fit = obj.at(th0).fit(th0, starts=starts, max_nfev=max_nfev, free_joint=free_joint)
+    if refresh:  # the first fit knows which effect values theta0 left out: their starts (spread, grid) are tried
+        fit = least_squares_fit(obj.at(th0), th0, given, starts, max_nfev, free_joint)
         for _ in range(refresh):
             again = obj.at(fit.theta).fit(fit.theta, starts=1, max_nfev=max_nfev, free_joint=free_joint)
             fit = replace(again, n_eval=again.n_eval + fit.n_eval)
         return fit
     return least_squares_fit(obj, th0, given, starts, max_nfev, free_joint)
+
+
+def _grid_start(obj, u0: NDArray, grids: Mapping[str, int]) -> NDArray | None:
+    """The best point of the even grid over the unit-cube ranges of the parameters `grids` names (points each),
+    the others at u0: one batched evaluation of the objective (None without a grid)."""
+    if not grids:
+        return None
+    c = obj.candidate
+    axes = [np.linspace(1e-6, 1 - 1e-6, grids[n]) if n in grids else np.array([u0[i]])
+            for i, n in enumerate(c.grown.names)]
+    U = np.stack([a.ravel() for a in np.meshgrid(*axes, indexing="ij")], axis=-1)
+    with np.errstate(all="ignore"):
+        cost = np.sum(obj.residuals(c.to_physical(U)) ** 2, axis=-1)
+    return U[int(np.nanargmin(cost))].copy() if np.isfinite(cost).any() else None
 
 
 def least_squares_fit(obj: Objective, th0: NDArray, given: Mapping[str, float], starts: int, max_nfev: int,
@@ -280,6 +298,9 @@ def least_squares_fit(obj: Objective, th0: NDArray, given: Mapping[str, float], 
         for s in np.linspace(0.15, 0.85, max(0, starts - 1)):
             u = u0.copy()
             u[spread] = s
+            inits.append(u)
+        u = _grid_start(obj, u0, {p.name: p.grid for p in c.effect_params if p.grid and p.name not in given})
+        if u is not None:
             inits.append(u)
     h = 1e-5
     count = [0]

@@ -39,7 +39,10 @@ Fingerprint = Callable[[Mapping[str, "float | None"], float, float], "tuple[bool
 
 @dataclass(frozen=True)
 class EffectParam:
-    """One parameter of an effect: name, unit, bounds lo..hi, log scaling, start value of a fit and meaning."""
+    """One parameter of an effect: name, unit, bounds lo..hi, log scaling, start value of a fit and meaning;
+    grid: points of an even grid over its range (in the fits' unit cube: log-spaced on a log scale) where a fit
+    first evaluates the misfit and also starts from the best (0: none), for a parameter whose misfit has
+    many valleys, such as a frequency (`jointcal.discrepancy.fit.least_squares_fit`)."""
 
     name: str
     unit: str
@@ -48,8 +51,11 @@ class EffectParam:
     log: bool
     start: float
     meaning: str
+    grid: int = 0
 
     def __post_init__(self) -> None:
+        if self.grid < 0 or self.grid == 1:
+            raise ValueError(f"effect parameter {self.name}: grid is 0 (none) or at least 2 points, got {self.grid!r}.")
         if not (self.lo < self.hi and self.lo <= self.start <= self.hi) or (self.log and self.lo <= 0):
             raise ValueError(f"effect parameter {self.name}: need lo < hi, lo <= start <= hi and lo > 0 on a log "
                              f"scale, got lo={self.lo!r}, hi={self.hi!r}, start={self.start!r}, log={self.log!r}.")
