@@ -256,8 +256,7 @@ def refreshed_fit(obj, theta0: NDArray, starts: int, max_nfev: int, free_joint: 
     start (``obj.at``) and again at each optimum, refitting from it (from the optimum alone).
 
     The first fit is told which effect values theta0 gave: the others are also started from spread points
-    and their grids (`least_squares_fit`). (Until 2026-11-26 the refreshing path passed the completed vector
-    on, so a fit with refresh tried the effect's start value alone, whatever `starts` said.)"""
+    and their grids (`least_squares_fit`), with refresh as without."""
     space = obj.candidate.grown
     given = dict(zip(space.names, map(float, theta0)))  # the space's leading columns
     th0 = space.vector(given, default={p.name: p.start for p in obj.candidate.effect_params})
