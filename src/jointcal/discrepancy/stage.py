@@ -169,10 +169,11 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
         f"E = {F:.2f}" + ("" if floor["E"] is not None else " (no validation frames to compare: taken as 0)"))
     clock.lap("floor")
     drive, unit = None, level_unit(modal.columns)
-    if gain is not None and unit == "V" and not refits_slope(unit, F):
+    voltage = gain is not None and unit == "V"
+    if voltage and not refits_slope(unit, F):
         say(f"{assembly}: the voltage drive's slope not refit: the fast model that would judge it is off its own "
             f"time simulation by E {F:.2f}, more than the repeat scatter")
-    elif gain is not None and refits_slope(unit, F):  # the coil's slope (`drive`)
+    elif voltage:  # the coil's slope (`drive`)
         def build(g):
             return _usable_runs(assembly, envs, mrows, [{**r, "drive_gain": g} for r in rows], sdb, sdeg, settings,
                                 zeta_min)
