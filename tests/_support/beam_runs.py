@@ -16,15 +16,16 @@ GAINS = {"force": (complex(G), 0j, 2 * np.pi * 100.0),  # 1/m at the driving poi
          "voltage": (complex(300.0, -150.0), complex(0.9, 0.6), 2 * np.pi * 100.0)}  # an amplifier's, sloped
 
 
-def _run(ref: str, level: float) -> tuple[pd.DataFrame, dict]:
-    """A linear up-chirp of the reference at `level` (lbf or V) and its manifest row with the drive gain."""
-    t = np.arange(0.0, (F1 - F0) / RATE + 2.0, 1 / FS)
-    r = level * np.sin(2 * np.pi * (F0 * t + 0.5 * RATE * t**2)) * np.minimum(1.0, t / 0.05)
-    r[t > (F1 - F0) / RATE] = 0.0
+def _run(ref: str, level: float, rate: float = RATE, f0: float = F0, f1: float = F1) -> tuple[pd.DataFrame, dict]:
+    """A linear up-chirp of the reference at `level` (lbf or V) and `rate` (Hz/s) from f0 to f1 (Hz), and its
+    manifest row with the drive gain."""
+    t = np.arange(0.0, (f1 - f0) / rate + 2.0, 1 / FS)
+    r = level * np.sin(2 * np.pi * (f0 * t + 0.5 * rate * t**2)) * np.minimum(1.0, t / 0.05)
+    r[t > (f1 - f0) / rate] = 0.0
     col, lev = ("force_lbf", "level_lbf") if ref == "force" else ("drive_V", "level_V")
     rec = pd.DataFrame({"time_s": t, col: r, "response_accel_g": np.zeros_like(t)})
-    row = {"run_id": "r1", "assembly": "beam", lev: level, "direction": "up", "f_start_hz": F0, "f_stop_hz": F1,
-           "sweep_rate_hz_per_s": RATE, "sample_rate_hz": FS, "sequence": 1, "drive_gain": GAINS[ref]}
+    row = {"run_id": "r1", "assembly": "beam", lev: level, "direction": "up", "f_start_hz": f0, "f_stop_hz": f1,
+           "sweep_rate_hz_per_s": rate, "sample_rate_hz": FS, "sequence": 1, "drive_gain": GAINS[ref]}
     return rec, row
 
 

@@ -172,10 +172,10 @@ def run_envelope(env: pd.DataFrame, row: Mapping, sigma_db: NDArray, sigma_deg: 
     eq = equivalent_base(row, f)
     if eq is not None:  # a force or voltage: the model is driven by the equivalent base acceleration
         ref = ref * eq
-    ok = full_drive(env, full_drive_fraction(row))
-    ok &= (f >= band[0] * f_res) & (f <= band[1] * f_res)
     L = _window_s(row, zeta_min)
-    ok &= within_sweep(env["time_s"].to_numpy(float), f, env["drive_on"].to_numpy(bool), row, L)
+    driven = full_drive(env, full_drive_fraction(row))
+    driven &= within_sweep(env["time_s"].to_numpy(float), f, env["drive_on"].to_numpy(bool), row, L)
+    ok = driven & (f >= band[0] * f_res) & (f <= band[1] * f_res)
     idx = np.flatnonzero(ok)
     if idx.size < MIN_FRAMES:
         return None
@@ -184,7 +184,7 @@ def run_envelope(env: pd.DataFrame, row: Mapping, sigma_db: NDArray, sigma_deg: 
     rate = float(np.median(np.gradient(f[ok], t[ok]))) if ok.sum() > 2 else 0.0
     x = np.abs(f[idx] / f_res - 1.0) / zeta
     b = np.clip(np.digitize(x, BINS[1:-1]), 0, len(BINS) - 2)
-    ok_t = np.flatnonzero(ok)
+    ok_t = np.flatnonzero(driven)  # the drive over the whole run: a fast sweep's windows and run-in reach past the band
     if eq is not None:  # a force or voltage: every frame between the run's first and last is its drive, the dip
         # at resonance too (there the envelopes may call the drive off: it is small, not absent)
         span = np.zeros(f.size, bool)

@@ -23,6 +23,7 @@ __all__ = ["swept_transmissibility", "ETA_MIN", "SPAN"]
 
 ETA_MIN = 0.02  # below this eta the first-order quasi-steady envelope is as close as the integrated one
 SPAN = 3.0  # integrated from x = -SPAN through the resonance, half-power half-widths
+START_TOL = 1e-3  # the start state's relative error left at the resonance (`run_in`)
 STEP = 0.4  # RK4 step: STEP / (largest |x| + 1) of the decay time 1 / (2 pi f_res zeta)
 
 
@@ -55,15 +56,16 @@ def swept_transmissibility(model: MinistackModel, drive: SweepDrive, t_s: ArrayL
     """
     t_out = np.atleast_1d(np.asarray(t_s, dtype=float))
     f_o, b_o, r_o, dl_o = drive.at(t_out)
-    rate = float(np.median(drive.rates[0]))
+    rate = _rate_at(drive, f_res_hz)
     direction = "up" if rate >= 0 else "down"
     R, _, A = _quasi_steady(model, f_o, b_o, r_o, dl_o, direction)
     T = (R / A)[0]
     eta = sweep_eta(rate, f_res_hz, zeta)
     sign = 1.0 if rate >= 0 else -1.0
     after = max(span, 1.2 * eta)
+    before = run_in(eta, span)
     x = sign * (drive.f_hz / f_res_hz - 1.0) / zeta
-    inside = np.flatnonzero((x >= -span) & (x <= after))
+    inside = np.flatnonzero((x >= -before) & (x <= after))
     L = drive.window_s
     if eta >= ETA_MIN and inside.size:
         ka = int(np.searchsorted(drive.t_s, drive.t_s[inside[0]] - L, side="right")) - 1
@@ -73,8 +75,30 @@ def swept_transmissibility(model: MinistackModel, drive: SweepDrive, t_s: ArrayL
         keep = (t_out - L / 2 >= t_a) & (t_out + L / 2 <= t_b)
         if keep.any():
             T[keep] = _integrated(model, drive, t_a, t_b, ka, t_out[keep], direction,
-                                  2 * np.pi * f_res_hz * zeta, max(span, after))
+                                  2 * np.pi * f_res_hz * zeta, max(before, after))
     return _channel(model, T[None], f_o, (1, t_out.size))[0]
+
+
+def run_in(eta: float, span: float = SPAN, tol: float = START_TOL) -> float:
+    """Half-power half-widths before the resonance where the integration starts: the smallest x >= span at
+    which the quasi-steady start state, wrong by about its own first-order term eta / (2 pi x^2), has decayed
+    to `tol` by the resonance, eta / (2 pi x^2) exp(-2 pi x / eta) <= tol (the sweep takes x / eta decay
+    times 1 / (2 pi f zeta) to get there). span for slow sweeps (eta below about 4); a fast sweep is
+    integrated from further back, from the drive's start when it is closer."""
+    if eta <= 0.0:
+        return span
+    x = np.geomspace(span, 1e6, 2000)
+    ok = eta / (2 * np.pi * x**2) * np.exp(-2 * np.pi * x / eta) <= tol
+    return float(x[np.argmax(ok)]) if ok.any() else float(x[-1])
+
+
+def _rate_at(drive: SweepDrive, f_res_hz: float) -> float:
+    """The sweep rate (Hz/s) where the drive crosses f_res: the median over the frames within a window of the
+    crossing (the drive's rate elsewhere, e.g. a log sweep's, does not set eta)."""
+    r = drive.rates[0]
+    t_res = drive.t_s[int(np.argmin(np.abs(drive.f_hz - f_res_hz)))]
+    near = np.abs(drive.t_s - t_res) <= drive.window_s
+    return float(np.median(r[near])) if near.sum() >= 3 else float(np.median(r))
 
 
 def _integrated(model: MinistackModel, drive: SweepDrive, t_a: float, t_b: float, ka: int, t_out: NDArray,
