@@ -20,15 +20,8 @@ them (no record), the windows' scatter about a quadratic in log q per run, poole
 the backbone's curvature for noise where a run spans two decades (the virtual Ministack: 7e-4 against the
 read-out's 5e-5 to 9e-5 in f).
 
-**E.** As the validation's: the RMS of the scaled errors of f and zeta, every run weighted equally (a
-ring-down counts once, however many windows it has, as in the calibration), and within a run each point by its
-share of the run's log-amplitude (`jointcal.validate.decay.log_q_share`). The estimator tiles a decay as the
-noise asks (`jointcal.measure.ringdown`: short windows at the top, windows grown towards ``ZETA_SE_AIM`` at the
-bottom; on the virtual beam four or five windows an e-fold at the top, one at the bottom); weighted by window, a
-held-out run's score would follow that tiling, and its errors are not uniform in amplitude (the top run,
-predicted beyond the fitted runs' amplitudes, carries the refit's own uncertainty, largest at its largest
-amplitudes). Weighted by its share of the amplitude, the score is the run's average over its decay whatever the
-windows.
+**E.** As the validation's: the RMS of the scaled errors of f and zeta, every run weighted equally
+(a ring-down counts once, however many windows it has, as in the calibration).
 
 **Folds.** Each run is held out in turn (its level, as the sweeps' folds; a run starts from its own amplitude,
 so the top run is predicted beyond the others' amplitudes). With ``bands`` > 1 each run's points are split in
@@ -41,7 +34,6 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from functools import cached_property
 
 import numpy as np
 import pandas as pd
@@ -51,7 +43,7 @@ from ..calibrate._readouts import QUAD
 from ..io import level_column
 from ..io.contract import UNUSABLE
 from ..models.free_decay import free_backbone
-from ..validate.decay import log_q_share, scales
+from ..validate.decay import scales
 from ..validate.testkinds import measured_read
 from .decay_readout import Factor, readout_factor
 from .fit import Candidate, Fit, model_at, refreshed_fit
@@ -88,11 +80,6 @@ class DecayRun:
     @property
     def run_id(self) -> str:
         return str(self.row["run_id"])
-
-    @cached_property
-    def share(self) -> NDArray[np.float64]:
-        """Each point's weight within its run (`log_q_share`), shape (n,)."""
-        return log_q_share(self.q_in)
 
 
 def read_scatter(points: Sequence[tuple[NDArray, NDArray, NDArray]]) -> tuple[float, float]:
@@ -297,11 +284,8 @@ class DecayObjective:
         f_m, z_m = self.points(theta)
         cat = lambda a: np.concatenate([getattr(r, a) for r in self.runs])  # noqa: E731
         ids = np.concatenate([[r.run_id] * r.q_in.size for r in self.runs])
-        share = cat("share")
-        _, inv = np.unique(ids, return_inverse=True)
-        total = np.bincount(inv, weights=share)
-        # every run weighted equally, its points within it by their share of its log-amplitude
-        w = np.sqrt(share / (2.0 * total[inv] * total.size))
+        _, inv, count = np.unique(ids, return_inverse=True, return_counts=True)
+        w = 1.0 / np.sqrt(2.0 * count[inv] * count.size)  # every run weighted equally, its windows within it
         with np.errstate(all="ignore"):
             rf = (f_m / cat("f_hz") - 1.0) / cat("sigma_f") * w
             rz = (z_m / cat("zeta") - 1.0) / cat("sigma_zeta") * w

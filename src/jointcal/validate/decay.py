@@ -20,11 +20,8 @@ The steps, in the order data flows (`decay_from_cut`, then `compare_decay`):
    bias (1-3% in zeta against closed forms) is the same in both and cancels.
 4. **The comparison** (`compare_decay`): at each measured window, the model's f and zeta at the same amplitude
    (interpolated in log q along the model's decay), as relative errors over the read-out's own uncertainty,
-   never less than the sweeps' floors in the same convention (`scales`); E_f and E_zeta their mean squares
-   with each window weighted by its share of the decay's log-amplitude (`log_q_share`), so that E is the
-   decay's average over its amplitudes whatever the estimator's tiling (short windows where the decay is loud,
-   long where the noise asks: a few windows an e-fold at the top, one at the bottom). The decay envelope in
-   time, the ratio of the amplitudes at each window, is reported beside them.
+   never less than the sweeps' floors in the same convention (`scales`). The decay envelope in time, the ratio
+   of the amplitudes at each window, is reported beside them.
 """
 from __future__ import annotations
 
@@ -39,8 +36,7 @@ from ..measure.ringdown import ringdown_at
 from ..models import MinistackModel
 from .drive import model_input, reference_column, response_to
 
-__all__ = ["decay_input", "decay_from_cut", "scales", "log_q_share", "compare_decay", "TOL", "TRIES", "RAMP",
-           "BEYOND"]
+__all__ = ["decay_input", "decay_from_cut", "scales", "compare_decay", "TOL", "TRIES", "RAMP", "BEYOND"]
 
 TOL = 0.002  # the model's first decay window's amplitude within this share of the measured one's
 TRIES = 8  # simulations at most to reach it
@@ -156,22 +152,6 @@ def scales(windows: pd.DataFrame, *, floor_db: float, floor_deg: float) -> tuple
     return sigma_f, sigma_z
 
 
-def log_q_share(q_in: NDArray) -> NDArray[np.float64]:
-    """Each point's share of its decay's log-amplitude: the span of log q nearer to it than to its neighbours (the
-    two ends' cells as deep outwards as inwards), shape (n,) from q_in (in, (n,), any order); equal shares for a
-    run of one point or of no span (a dwell's phase resonance)."""
-    q = np.asarray(q_in, dtype=float)
-    lq = np.log(q)
-    if q.size < 2 or not np.all(np.isfinite(lq)) or np.ptp(lq) <= 0:
-        return np.ones(q.size)
-    o = np.argsort(lq)
-    x = lq[o]
-    edges = np.r_[1.5 * x[0] - 0.5 * x[1], 0.5 * (x[1:] + x[:-1]), 1.5 * x[-1] - 0.5 * x[-2]]
-    out = np.empty(q.size)
-    out[o] = np.diff(edges)
-    return out
-
-
 def compare_decay(meas: pd.DataFrame, sim: pd.DataFrame, *, floor_db: float = 0.05,
                   floor_deg: float = 0.3) -> tuple[pd.DataFrame, dict]:
     """The model's decay against the measured one, window by window, at the same amplitude.
@@ -198,7 +178,7 @@ def compare_decay(meas: pd.DataFrame, sim: pd.DataFrame, *, floor_db: float = 0.
     metrics : dict
         n_windows (compared), decades, q_first_meas_in, q_first_sim_in, f_rel_err_mean, f_rel_err_rms,
         zeta_rel_err_mean, zeta_rel_err_rms, env_end_db (at the last window), E_f, E_zeta (rms of r_f and
-        r_zeta, each window weighted by its share of the compared windows' log-amplitude, `log_q_share`).
+        r_zeta).
     """
     q_m, q_s = meas["q_in"].to_numpy(float), sim["q_in"].to_numpy(float)
     ok = np.isfinite(q_s) & (q_s > 0) & (sim["zeta"].to_numpy(float) > 0)
@@ -218,13 +198,11 @@ def compare_decay(meas: pd.DataFrame, sim: pd.DataFrame, *, floor_db: float = 0.
     b = frames[frames["in_range"]]
     rms = lambda v: float(np.sqrt(np.mean(v**2))) if len(v) else np.nan  # noqa: E731
     mean = lambda v: float(np.mean(v)) if len(v) else np.nan  # noqa: E731
-    share = log_q_share(b["q_meas_in"].to_numpy(float))
-    wrms = lambda v: float(np.sqrt(np.sum(share * v**2) / np.sum(share))) if len(v) else np.nan  # noqa: E731
     metrics = {"n_windows": int(len(b)), "decades": float(np.log10(q_m.max() / q_m.min())) if q_m.size else np.nan,
                "q_first_meas_in": float(q_m[0]) if q_m.size else np.nan,
                "q_first_sim_in": float(q_s[0]) if q_s.size else np.nan,
                "f_rel_err_mean": mean(b["d_f_rel"]), "f_rel_err_rms": rms(b["d_f_rel"]),
                "zeta_rel_err_mean": mean(b["d_zeta_rel"]), "zeta_rel_err_rms": rms(b["d_zeta_rel"]),
                "env_end_db": float(frames["d_env_db"].iloc[-1]) if len(frames) else np.nan,
-               "E_f": wrms(b["r_f"]), "E_zeta": wrms(b["r_zeta"])}
+               "E_f": rms(b["r_f"]), "E_zeta": rms(b["r_zeta"])}
     return frames, metrics

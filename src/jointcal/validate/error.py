@@ -184,8 +184,7 @@ def envelope_error(frames: Mapping[str, pd.DataFrame], metrics: pd.DataFrame, sc
     Dwells and ring-downs (metrics' ``test``; `jointcal.validate.testkinds`) bring their own parts: a dwell's
     steady point the same dM and dP over its own uncertainty (one "frame", in E_mag and E_phase); a decay the
     relative errors of f and zeta at each measured window's amplitude over the read-out's own standard errors
-    (`jointcal.validate.decay.scales`), whose mean squares over the windows (each by its share of the decay's
-    log-amplitude, `jointcal.validate.decay.log_q_share`) are the run's E_f^2 and E_zeta^2.
+    (`jointcal.validate.decay.scales`), whose mean squares over the windows are the run's E_f^2 and E_zeta^2.
     A run's E^2 is the mean of the parts it has ((E_mag^2 + E_phase^2) / 2 for a sweep), and the assembly's
     E^2 the mean of its runs' (so a sweep-only campaign's E is the definition above).
 
