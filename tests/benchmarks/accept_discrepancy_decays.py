@@ -267,7 +267,8 @@ def run_case(effect: str, params: dict, seed: int, rig: str = "beam") -> dict:
                     f"{k} {v['value']:.3g}" for k, v in eff.items())
     return dict(effect=d["effect"], confidence=d["confidence"], E_before=d["metric_before"], E_after=d["metric_after"],
                 floor=d["fast_model_floor"]["E"], params=got, stage_s=t2 - t1, total_s=t2 - t0,
-                not_seen=",".join(d["not_seen_by_decays"]))
+                not_seen=",".join(d["not_seen_by_decays"]),
+                scores=" ".join(f"{c['name']} {c['held_out_score']:.2f}" for c in [{'name': 'baseline', **d['baseline']}, *d['candidates'][:3]]))
 
 
 def main(argv=None):
@@ -288,7 +289,7 @@ def main(argv=None):
             change = r["E_after"] / r["E_before"] - 1
             line = (f"{label:36s} seed {seed}: {r['effect']:36s} {r['confidence']:6s} E {r['E_before']:6.2f} -> "
                     f"{r['E_after']:5.2f} ({change:+5.0%})  floor {r['floor']:.2f}  {ok:4s} {r['params']}  "
-                    f"stage {r['stage_s']:.0f} s")
+                    f"stage {r['stage_s']:.0f} s; scores {r['scores']}")
             print(line, flush=True)
             lines.append(line)
             if a.out:
