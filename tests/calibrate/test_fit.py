@@ -75,3 +75,40 @@ def test_qsma_calibration_absorbs_its_bias_into_the_parameters():
     assert k0(t_qs) / k0(t_hb) - 1 > 2e-3  # QSMA's is off
     assert t_hb[2] == pytest.approx(FIRST[2], abs=2e-3) and abs(t_qs[2] - t_hb[2]) > 5e-3  # chi
     assert t_hb[5] == pytest.approx(FIRST[5], rel=0.02) and t_qs[5] < 0.8 * t_hb[5]  # zeta_v absorbs the rest
+
+
+# ---------------------------------------------------------------- points with their own standard errors
+
+def test_the_polish_of_windows_with_standard_errors_is_the_validations_E_of_the_backbone():
+    """Oracle: each run's mean over its windows of (r_f^2 + r_zeta^2) / 2, r the relative error over the window's
+    own scale, averaged over runs (`jointcal.validate.error.envelope_error` on `compare_decay`'s r_f, r_zeta),
+    written out here by hand: the polish's residuals' squared norm is it."""
+    from jointcal.calibrate.data import ModalData
+    from jointcal.calibrate.fit import _residuals
+
+    rng = np.random.default_rng(3)
+    q = np.concatenate([np.geomspace(1e-4, 3e-6, 12), np.geomspace(3e-5, 2e-6, 7)])
+    runs = np.array(["a"] * 12 + ["b"] * 7)
+    f, z = harmonic_balance(q, *FIRST[:5], M, FIRST[5])
+    f, z = f * (1 + 1e-4 * rng.standard_normal(q.size)), z * (1 + 1e-2 * rng.standard_normal(q.size))
+    s_f, s_z = rng.uniform(5e-5, 2e-4, q.size), rng.uniform(3e-3, 1e-2, q.size)
+    w = np.where(runs == "a", 1 / 12, 1 / 7)
+    data = ModalData("first", tuple(runs), np.full(q.size, np.nan), q, f, z, "zeta_res", (np.nan, np.nan), (), w,
+                     (s_f, s_z), q)
+    s = CalibrateSettings()
+    theta = FIRST * np.array([1.1, 0.95, 1.0, 1.2, 1.02, 0.9])
+    f_m, z_m = harmonic_balance(q, *theta[:5], M, theta[5])
+    r_f, r_z = (f - f_m) / f / s_f, (z - z_m) / z / s_z
+    E2 = np.mean([np.mean((r_f[runs == r] ** 2 + r_z[runs == r] ** 2) / 2) for r in ("a", "b")])
+    assert np.sum(_residuals(theta[None], data, s, s.space) ** 2) == pytest.approx(E2, rel=1e-12)
+
+
+def test_a_knee_within_the_windows_must_earn_its_place():
+    """Tied optima (within chi^2(1) at 95% of the lowest): the fewest windows in macroslip wins, then the lowest;
+    a knee that fits better than that keeps its place."""
+    from jointcal.calibrate.fit import TIE, pick_polished
+
+    assert TIE == pytest.approx(3.84)
+    assert pick_polished([10.0, 12.0, 13.5], [1, 0, 0]) == 1
+    assert pick_polished([10.0, 14.0], [1, 0]) == 0
+    assert pick_polished([np.nan, 10.0, 11.0], [0, 2, 1]) == 2

@@ -167,3 +167,52 @@ def test_each_modal_effect_hidden_in_a_force_campaign_is_named_by_the_rule(hidde
         print(f"E: truth {E_truth:.2f}, named fit {named.fit.E:.2f}, baseline fit {base.fit.E:.2f}")
         assert base.fit.E >= 1.5 * E_truth
         assert base.fit.E - named.fit.E >= CLOSE_FRACTION * (base.fit.E - E_truth)
+
+
+class _Line:
+    """A straight line a + b x against points y at x, standard error 1, weights w (squares summing to 1): the
+    least-squares textbook case, as an objective `predictive_E` takes (the parameters' unit cube maps to -10..10)."""
+
+    def __init__(self, x, y, w):
+        self.x, self.y, self.w = np.asarray(x, float), np.asarray(y, float), np.asarray(w, float)
+        grown = type("Space", (), {"free_mask": lambda self, held=(): np.ones(2, bool)})()
+        self.candidate = type("Line", (), {"grown": grown, "to_unit": staticmethod(lambda th: (th + 10.0) / 20.0),
+                                           "to_physical": staticmethod(lambda u: 20.0 * u - 10.0)})()
+
+    def residuals(self, theta):
+        th = np.asarray(theta, float)
+        return self.w * (th[..., :1] + th[..., 1:] * self.x - self.y)
+
+    def weights(self):
+        return self.w
+
+
+def _wls(x, y, w):
+    """The weighted least-squares line (a, b) minimising sum w^2 (a + b x - y)^2."""
+    return np.linalg.lstsq(w[:, None] * np.c_[np.ones_like(x), x], w * y, rcond=None)[0]
+
+
+def test_the_predictive_deviance_of_a_refit_line_is_the_textbook_prediction_variance():
+    """Oracles: the textbook variance of an extrapolated least-squares line, sigma^2 (1 + x0^T (X^T X)^-1 x0),
+    for equal weights; for unequal ones, the scatter of the refit's extrapolation over 4000 noise draws."""
+    from jointcal.discrepancy.select import predictive_E
+    x = np.linspace(0.0, 1.0, 8)
+    X = np.c_[np.ones_like(x), x]
+    theta = np.array([0.3, -1.2])
+    for x0 in (0.5, 3.0):  # inside the fitted span, and beyond it
+        v = np.array([1.0, x0]) @ np.linalg.inv(X.T @ X) @ np.array([1.0, x0])
+        for z in (0.0, 2.5):  # the held-out point z standard errors off the refit's prediction
+            test = _Line([x0], [theta[0] + theta[1] * x0 - z], [1.0])
+            E = predictive_E(_Line(x, x * 0.0, np.full(8, 8**-0.5)), test, theta)
+            assert E == pytest.approx(np.sqrt(z**2 / (1 + v) + np.log1p(v)), rel=1e-6)
+    # unequal weights (a run of 2 points and one of 6, each run counting once): the sandwich's v against the
+    # extrapolation's scatter; a point exactly on the prediction reads ln(1 + v) alone
+    w = np.r_[np.full(2, 0.5), np.full(6, 1 / np.sqrt(12))]
+    x0, rng = 2.5, np.random.default_rng(7)
+    pred = [np.r_[1.0, x0] @ _wls(x, theta[0] + theta[1] * x + rng.standard_normal(8), w) for _ in range(4000)]
+    on = _Line([x0], [theta[0] + theta[1] * x0], [1.0])
+    v = np.expm1(predictive_E(_Line(x, x * 0.0, w), on, theta) ** 2)
+    assert v == pytest.approx(np.var(pred), rel=0.06)  # 4000 draws: the variance to 2.2% (1 sd)
+    # a point 10 standard errors off, where the refit's own scatter is 2.3 (v 5.2): charged 10^2 / (1 + v) + ln(1 + v)
+    far = _Line([x0], [theta[0] + theta[1] * x0 - 10.0], [1.0])
+    assert predictive_E(_Line(x, x * 0.0, w), far, theta) ** 2 == pytest.approx(100 / (1 + v) + np.log1p(v))

@@ -10,6 +10,7 @@ from jointcal.io import ingest_campaign, read_run
 from jointcal.measure.campaign import campaign_modal
 from jointcal.measure.scatter import scatter
 from jointcal.measure.testkinds.read import BACKBONE_COLUMNS, backbone_table
+from jointcal.measure.testkinds.ringdown import SE_COLUMNS
 from tests._support.kinds_records import FN, ZETA, dwell_row, kinds_campaign, linear_dwell
 
 FREQS = (19.3, 19.9, 20.2, 20.5, 21.1)
@@ -42,8 +43,11 @@ def test_each_run_keeps_one_modal_row_read_at_the_mode(modal):
 
 def test_the_backbone_holds_every_dwell_point_and_every_ring_down_window(modal):
     table, points, bb = modal
-    assert list(bb.columns) == BACKBONE_COLUMNS and len(bb) == len(points)
+    assert list(bb.columns) == BACKBONE_COLUMNS + list(SE_COLUMNS) and len(bb) == len(points)
     assert (bb["test"] == "dwell").sum() == 5
+    assert bb.loc[bb["test"] == "dwell", list(SE_COLUMNS)].isna().all().all()  # a window's length and errors only
+    assert (bb.loc[bb["test"] == "ringdown", list(SE_COLUMNS)] > 0).all().all()
+    assert list(backbone_table(table, []).columns) == BACKBONE_COLUMNS  # without windows (sweeps): the six
     rd = bb[bb["test"] == "ringdown"]
     assert set(rd["run_id"]) == {f"d{i}" for i in range(5)} | {"r1"}  # the dwells' own ring-downs too
     # a linear mode: the issue's 0.1% / 3% on every window, over more than a decade of amplitude

@@ -51,7 +51,8 @@ def test_the_truth_validates_within_the_read_outs_own_uncertainty(lab):
     # every decay compared over 1.5 decades or more, from the measured amplitude at the cut reached under the
     # measured drive itself (the model exact: c = 1, its first window's amplitude within 0.2%)
     assert (m["decades"] > 1.5).all() and (m["drive_scale"] == 1.0).all()
-    assert (m["n_windows"] > 15).all() and (m["n_frames"] == m["n_windows"] + (m["test"] == "dwell")).all()
+    # 15-18 windows per decay (measured; each grows towards ZETA_SE_AIM where the noise asks, so fewer than at 1%)
+    assert (m["n_windows"] >= 12).all() and (m["n_frames"] == m["n_windows"] + (m["test"] == "dwell")).all()
     # measured (seed 11): E 0.72 (dwell points 0.15 / 0.11, decays' f 0.94, zeta 0.93; no run's part above 1.27),
     # f within 8e-6 and zeta within 0.14% of the measured at the same amplitude (the runs' means)
     assert v.error["E"] < 1.0 and v.error["E_mag"] < 0.3 and v.error["E_phase"] < 0.3

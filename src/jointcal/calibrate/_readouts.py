@@ -25,6 +25,12 @@ over the amplitudes it swept through and fix the backbone's shape there. Eq. 3.9
 1/sum(w) and each squared residual is multiplied by its weight; the likelihood raises each
 point's Gaussian to its weight (`jointcal.posterior.likelihood`). With sweeps only every weight is
 1 and both are what they were.
+
+**Standard errors.** A window's read-out has its own standard errors of f and zeta (backbone.csv's
+``f_se_hz``, ``zeta_se``, where the modal stage wrote them); they come along as relative scales
+(`jointcal.measure.testkinds.ringdown.window_scales`, floored as the validation floors them), with the
+amplitude at the window's start, q exp(pi f zeta T) for a window of T = ``window_s`` (its envelope decays at
+2 pi f zeta), NaN for every other point. The polish weighs the points by them (`jointcal.calibrate.fit`).
 """
 from __future__ import annotations
 
@@ -34,6 +40,7 @@ import pandas as pd
 from ..measure.testkinds import estimator_of
 from ..measure.testkinds.dwell import STEADY
 from ..measure.testkinds.ringdown import METHOD as WINDOWS
+from ..measure.testkinds.ringdown import SE_COLUMNS, window_scales
 
 __all__ = ["expand", "QUAD"]
 
@@ -55,6 +62,16 @@ def _windows(backbone: pd.DataFrame, run_id: str, mode) -> pd.DataFrame:
     if mode is not None and "mode" in w and pd.notna(mode):
         w = w[w["mode"].astype(str) == str(mode)]
     return w[_positive(w, _VALUES)]
+
+
+def _scales(w: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The windows' relative scales of f and zeta (`window_scales`) and their amplitudes at their starts (in), NaN
+    where backbone.csv has no lengths and standard errors."""
+    if not all(c in w for c in SE_COLUMNS):
+        return (np.full(len(w), np.nan),) * 3
+    length, f_se, z_se = (pd.to_numeric(w[c], errors="coerce").to_numpy(float) for c in SE_COLUMNS)
+    q, f, z = (w[c].to_numpy(float) for c in _VALUES)
+    return (*window_scales(f, z, f_se, z_se), q * np.exp(np.pi * f * z * length))
 
 
 def expand(rows: pd.DataFrame, backbone: pd.DataFrame, level: np.ndarray, columns: tuple[str, str, str],
@@ -79,19 +96,23 @@ def expand(rows: pd.DataFrame, backbone: pd.DataFrame, level: np.ndarray, column
     -------
     points : dict
         ``run_id`` (str; a level's dwells joined by '+'), ``level``, ``q`` (in), ``f`` (Hz), ``zeta``,
-        ``weight``: arrays of one length, in the table's order of runs (a ring-down's windows in time
+        ``weight``, ``sigma_f``, ``sigma_zeta`` (relative scales of a window's f and zeta, `window_scales`),
+        ``q_top`` (in, the amplitude at a window's start; these three NaN where the point has none): arrays of
+        one length, in the table's order of runs (a ring-down's windows in time
         order), each level's dwells after them.
     notes : list of str
         What each ring-down and dwell level became, for the log.
     """
     method = rows["f_res_method"].astype(str) if "f_res_method" in rows else pd.Series("", index=rows.index)
-    out: dict[str, list] = {k: [] for k in ("run_id", "level", "q", "f", "zeta", "weight")}
+    out: dict[str, list] = {k: [] for k in ("run_id", "level", "q", "f", "zeta", "weight", "sigma_f", "sigma_zeta",
+                                            "q_top")}
     notes: list[str] = []
 
-    def add(rid, lev, q, f, z, w):
+    def add(rid, lev, q, f, z, w, sigma=(np.nan, np.nan, np.nan)):
         n = len(np.atleast_1d(q))
         for key, v in (("run_id", [rid] * n if isinstance(rid, str) else rid), ("level", [lev] * n),
-                       ("q", q), ("f", f), ("zeta", z), ("weight", [w] * n)):
+                       ("q", q), ("f", f), ("zeta", z), ("weight", [w] * n),
+                       *((k, np.broadcast_to(v, (n,))) for k, v in zip(("sigma_f", "sigma_zeta", "q_top"), sigma))):
             out[key] += list(np.atleast_1d(v))
 
     qc, fc, zc = columns
@@ -105,7 +126,7 @@ def expand(rows: pd.DataFrame, backbone: pd.DataFrame, level: np.ndarray, column
         if est is not None:
             w = _windows(backbone, rid, r.get("mode"))
             if len(w):
-                add(rid, level[i], w[_VALUES[0]], w[_VALUES[1]], w[_VALUES[2]], 1.0 / len(w))
+                add(rid, level[i], w[_VALUES[0]], w[_VALUES[1]], w[_VALUES[2]], 1.0 / len(w), _scales(w))
                 notes.append(f"{where}: run {rid!r}: its ring-down's {len(w)} windows over "
                              f"{np.log10(w['q_in'].max() / w['q_in'].min()):.2f} decades of amplitude, one read-out "
                              f"(weight 1/{len(w)} each)")

@@ -72,6 +72,12 @@ class ModalData:
     notes : tuple of str -- exclusions and floors applied, for the log.
     weight : ndarray, shape (N,), or None -- each point's weight in eq. 3.9 and the likelihood (a
         ring-down's k windows 1/k each: `jointcal.calibrate._readouts`); None: 1 each.
+    sigma : (ndarray, ndarray), each shape (N,), or None -- each point's own relative standard error of f
+        and of zeta (a ring-down window's read-out, floored as the validation floors it:
+        `jointcal.measure.testkinds.ringdown.window_scales`); set only when every point has them (a
+        campaign of ring-downs alone, read with backbone.csv's ``f_se_hz`` and ``zeta_se``), None otherwise.
+    q_top : ndarray, shape (N,), or None -- with `sigma`: the amplitude at each window's start, in (the
+        largest its read-out spans).
 
     The arrays hold one entry per point: per run, or per ring-down window and level of dwells when
     the points came from backbone.csv (``run_id`` then repeats a run, or joins a level's dwells).
@@ -87,6 +93,8 @@ class ModalData:
     rel_noise: tuple[float, float]
     notes: tuple[str, ...]
     weight: NDArray[np.float64] | None = None
+    sigma: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
+    q_top: NDArray[np.float64] | None = None
 
     @property
     def w(self) -> NDArray[np.float64]:
@@ -198,7 +206,7 @@ def select_modal(modal: pd.DataFrame, assembly: str, *, damping: Damping = "zeta
     level_col = level_column(rows.columns)
     level = (np.full(len(rows), np.nan) if level_col is None
              else pd.to_numeric(rows[level_col], errors="coerce").to_numpy(float))
-    run_id, weight = tuple(map(str, rows["run_id"])), None
+    run_id, weight, sigma, q_top = tuple(map(str, rows["run_id"])), None, None, None
     method = rows["f_res_method"].astype(str) if "f_res_method" in rows else pd.Series([], dtype=str)
     if backbone is not None and method.isin(methods()).any():  # a test kind's read-outs: its points in backbone
         missing = [c for c in BACKBONE_COLUMNS if c not in backbone.columns]
@@ -208,6 +216,9 @@ def select_modal(modal: pd.DataFrame, assembly: str, *, damping: Damping = "zeta
         pts, more = expand(rows, backbone, level, ("q_in", FREQUENCY, damping), backbone_name)
         notes += more
         run_id, level, weight = tuple(map(str, pts["run_id"])), pts["level"], pts["weight"]
+        own = np.isfinite(pts["sigma_f"]) & np.isfinite(pts["sigma_zeta"]) & np.isfinite(pts["q_top"])
+        if own.all():  # every point a window with its own standard errors: the polish's scale (`calibrate.fit`)
+            sigma, q_top = (pts["sigma_f"], pts["sigma_zeta"]), pts["q_top"]
         values = {"q_in": pts["q"], FREQUENCY: pts["f"], damping: pts["zeta"]}
     floors = {"frequency": 1e-4, "damping": 0.01, **(floors or {})}
     noise = (float("nan"), float("nan"))
@@ -220,7 +231,8 @@ def select_modal(modal: pd.DataFrame, assembly: str, *, damping: Damping = "zeta
                  _pooled(scatter, str(assembly), damping, floors["damping"], scatter_name, notes))
     return ModalData(assembly=str(assembly), run_id=run_id, level=level,
                      q=values["q_in"], f=values[FREQUENCY], zeta=values[damping], damping=damping,
-                     rel_noise=noise, notes=tuple(notes), weight=weight)
+                     rel_noise=noise, notes=tuple(notes), weight=weight, sigma=sigma,
+                     q_top=q_top)
 
 
 def read_table(path: str | os.PathLike[str]) -> pd.DataFrame:

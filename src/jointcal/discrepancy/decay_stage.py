@@ -20,7 +20,9 @@
    calibration and from its other valleys (``joint_starts``: beta is held, and the Iwan alone made to follow a
    hardening backbone sits with its macroslip knee at the top amplitude, a valley a hidden stiffening's model
    does not share), scored on held-out runs (amplitude bands on request) (`decays.decay_folds`,
-   `select.score_candidates`); pairs by forward selection when the rule asks.
+   `select.score_candidates`), each fold's E its predictive deviance (`select.predictive_E`: a ring-down
+   has a few windows, each a few standard errors of the refit's own extrapolation from the other runs, which
+   the plain E charged as the model's error); pairs by forward selection when the rule asks.
 3. Decide by `rule.decide` with F; 4. recalibrate the named (or baseline) model by the calibration's GA and
    the posterior in the grown space (`recalibrate`); revalidate every run by the time simulation
    (`jointcal.validate.validate_runs`: the decays from the record's state at the cut) -> E before and after,
@@ -216,7 +218,7 @@ def diagnose_decays(assembly: str, backbone: pd.DataFrame, modal: pd.DataFrame, 
         metric_before = float(v0.error["E"]) if metric_before is None else metric_before
     c0 = candidate("baseline", space, m, scales)
     folds = decay_folds(runs)
-    kw = dict(objective=DecayObjective, folds=folds, log=say)
+    kw = dict(objective=DecayObjective, folds=folds, log=say, predictive=True)
     # every candidate from the calibration and from its other valleys: beta is held at the start's value, and the
     # Iwan alone made to follow a hardening backbone sits with its macroslip knee at the top amplitude, a valley a
     # hidden stiffening's model does not share (its read-out there is the knee's, not the backbone's)

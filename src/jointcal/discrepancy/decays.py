@@ -286,14 +286,20 @@ class DecayObjective:
         """Residual vector whose sum of squares is E^2 (theta (n,) -> (m,), (P, n) -> (P, m))."""
         f_m, z_m = self.points(theta)
         cat = lambda a: np.concatenate([getattr(r, a) for r in self.runs])  # noqa: E731
-        ids = np.concatenate([[r.run_id] * r.q_in.size for r in self.runs])
-        _, inv, count = np.unique(ids, return_inverse=True, return_counts=True)
-        w = 1.0 / np.sqrt(2.0 * count[inv] * count.size)  # every run weighted equally, its windows within it
+        w = self.weights()[: f_m.shape[-1]]
         with np.errstate(all="ignore"):
             rf = (f_m / cat("f_hz") - 1.0) / cat("sigma_f") * w
             rz = (z_m / cat("zeta") - 1.0) / cat("sigma_zeta") * w
         r = np.concatenate([rf, rz], axis=-1)
         return np.where(np.isfinite(r), r, 1e3)
+
+    def weights(self) -> NDArray:
+        """Each residual's weight w (m,): a residual is w times its error in standard errors. Every run counts
+        once, its windows equally within it, so the weights' squares sum to 1 (E 1 = errors at the scatter)."""
+        ids = np.concatenate([[r.run_id] * r.q_in.size for r in self.runs])
+        _, inv, count = np.unique(ids, return_inverse=True, return_counts=True)
+        w = 1.0 / np.sqrt(2.0 * count[inv] * count.size)
+        return np.concatenate([w, w])
 
     def E(self, theta: NDArray) -> float:
         return float(np.sqrt(np.sum(self.residuals(theta) ** 2)))

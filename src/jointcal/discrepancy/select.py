@@ -38,9 +38,9 @@ import numpy as np
 
 from .data import RunEnvelope
 from ..io import level_unit
-from .fit import Candidate, Fit, Objective
+from .fit import HELD, Candidate, Fit, Objective
 
-__all__ = ["PENALTY_PER_PARAM", "Scored", "score_candidates"]
+__all__ = ["PENALTY_PER_PARAM", "Scored", "score_candidates", "predictive_E"]
 
 PENALTY_PER_PARAM = 0.02
 
@@ -88,17 +88,57 @@ def _extrapolates_sequence(runs: Sequence[RunEnvelope], idx: list[int]) -> bool:
     return bool(outside.mean() > 0.5)
 
 
-def _held_out(obj: Objective, full: Fit, max_nfev: int, folds: dict[str, list[int]]) -> dict[str, float]:
+def _held_out(obj: Objective, full: Fit, max_nfev: int, folds: dict[str, list[int]],
+              predictive: bool = False) -> dict[str, float]:
     """E of the candidate refit without each fold, on that fold (folds it cannot be judged on left out); the
-    objective is linearised at the full fit."""
+    objective is linearised at the full fit. predictive: the fold's E as its predictive deviance
+    (`predictive_E`)."""
     per = {}
     for name, idx in folds.items():
         if obj.candidate.sequence_dependent and _extrapolates_sequence(obj.runs, idx):
             continue
         train = [i for i in range(len(obj.runs)) if i not in set(idx)]
         f = obj.subset(train).fit(full.theta, starts=1, max_nfev=max_nfev)
-        per[name] = obj.subset(idx).E(f.theta)
+        per[name] = (predictive_E(obj.subset(train), obj.subset(idx), f.theta) if predictive
+                     else obj.subset(idx).E(f.theta))
     return per
+
+
+def _unit_jacobian(obj, u: np.ndarray, idx: np.ndarray, h: float = 1e-5) -> tuple[np.ndarray, np.ndarray]:
+    """An objective's residuals at the unit-cube point u and their forward-difference Jacobian in the columns
+    idx: (m,), (m, k)."""
+    c = obj.candidate
+    r0 = obj.residuals(c.to_physical(u))
+    U = np.repeat(u[None], idx.size, axis=0)
+    step = np.where(u[idx] + h <= 1.0, h, -h)
+    U[np.arange(idx.size), idx] += step
+    return r0, ((obj.residuals(c.to_physical(U)) - r0) / step[:, None]).T
+
+
+def predictive_E(train, test, theta: np.ndarray) -> float:
+    """The held-out E of a model refit on `train`, at theta, as the Gaussian predictive deviance on `test`.
+
+    A residual is r_i = w_i z_i, z_i its error in standard errors (the objective's ``weights`` w, squares
+    summing to 1). The refit's parameters scatter with the fitted points' noise: linearised, with J the fitted
+    residuals' Jacobian in the free unit-cube columns not on a bound (a parameter on its bound is held there),
+    cov = (J^T J)^-1 J^T W^2 J (J^T J)^-1, W = diag(w). A held-out point's predictive variance in standard
+    errors is then 1 + v_i, v_i = g_i cov g_i^T / w_i^2 (g_i its row of the Jacobian), and its deviance
+    z_i^2 / (1 + v_i) + ln(1 + v_i): a model whose extrapolation is as uncertain as its error is not
+    charged the error twice, and an uncertain one pays the logarithm. Returns
+    E = sqrt(sum_i r_i^2 / (1 + v_i) + w_i^2 ln(1 + v_i)): the plain E with v = 0; E 1 at the scatter.
+    """
+    c = train.candidate
+    u = c.to_unit(np.asarray(theta, dtype=float))
+    free = c.grown.free_mask(HELD) & (u > 1e-4) & (u < 1.0 - 1e-4)
+    idx = np.flatnonzero(free)
+    r, G = _unit_jacobian(test, u, idx)
+    if idx.size == 0:
+        return float(np.sqrt(np.sum(r**2)))
+    _, J = _unit_jacobian(train, u, idx)
+    # g cov g^T = |g J^+ W|^2 (J^+ the pseudo-inverse): the same, and never negative by rounding
+    w2 = test.weights() ** 2
+    v = np.sum((G @ np.linalg.pinv(J, rcond=1e-10) * train.weights()) ** 2, axis=1) / w2
+    return float(np.sqrt(np.sum(r**2 / (1.0 + v) + w2 * np.log1p(v))))
 
 
 def _rms(values) -> float:
@@ -108,7 +148,7 @@ def _rms(values) -> float:
 def score_candidates(cands: Sequence[Candidate], runs: Sequence[RunEnvelope], theta_base, *,
                      max_nfev: int = 40, log=None, baseline: Scored | None = None,
                      starts: dict[str, Sequence[np.ndarray]] | None = None, objective=Objective,
-                     folds: dict[str, list[int]] | None = None) -> list[Scored]:
+                     folds: dict[str, list[int]] | None = None, predictive: bool = False) -> list[Scored]:
     """Fit every candidate on all runs, then score it on held-out folds (see the module notes).
 
     The baseline is scored first (added if `cands` lacks it and `baseline` is not given): the
@@ -117,7 +157,8 @@ def score_candidates(cands: Sequence[Candidate], runs: Sequence[RunEnvelope], th
     parameters and the values of its first effects, e.g. a single effect's fit for a pair);
     the fit from each is made and the lowest E on all runs kept (default: theta_base). objective : the
     objective of a candidate on the runs (the sweeps' `Objective`; ring-downs: `decays.DecayObjective`);
-    folds : the held-out folds (default: the sweeps' levels, directions and rates, `_folds`).
+    folds : the held-out folds (default: the sweeps' levels, directions and rates, `_folds`); predictive :
+    each fold's E as its predictive deviance (`predictive_E`; an objective with ``weights``).
     """
     cands = sorted(cands, key=lambda c: c.name != "baseline")
     if baseline is None and (not cands or cands[0].name != "baseline"):
@@ -131,7 +172,7 @@ def score_candidates(cands: Sequence[Candidate], runs: Sequence[RunEnvelope], th
         fits = [obj.fit(start, starts=1 if c.name == "baseline" else 3, max_nfev=max_nfev, refresh=1)
                 for start in (starts or {}).get(c.name, [theta_base])]
         full = min(fits, key=lambda f: f.E)
-        per = _held_out(obj.at(full.theta), full, max_nfev, folds) if folds else {}
+        per = _held_out(obj.at(full.theta), full, max_nfev, folds, predictive) if folds else {}
         if c.name == "baseline":
             base_per = per
             s = _rms(per.values()) if per else full.E

@@ -34,6 +34,7 @@ from numpy.typing import NDArray
 from ..io.contract import REFERENCE
 from ..measure.ringdown import ringdown_at
 from ..measure.testkinds.ringdown import METHOD as PART
+from ..measure.testkinds.ringdown import window_scales
 from ..models import MinistackModel
 from .drive import model_input, reference_column, response_to
 
@@ -137,20 +138,15 @@ def decay_from_cut(model: MinistackModel, record: pd.DataFrame, row: Mapping, wi
 
 def scales(windows: pd.DataFrame, *, floor_db: float, floor_deg: float) -> tuple[NDArray, NDArray]:
     """Each window's scale of the relative errors in f and zeta: the read-out's own standard errors
-    (``f_se_hz`` / f, ``zeta_se`` / zeta), never less than the sweeps' floors in the same convention.
-
-    A resonance's peak is proportional to 1 / zeta, so the magnitude floor ``floor_db`` is a relative damping
-    10^(floor_db / 20) - 1 (0.05 dB: 0.58%); the phase at resonance turns by 1 / zeta rad per unit f / f_n, so
-    the phase floor ``floor_deg`` is a relative frequency zeta floor_deg pi / 180 (0.3 deg at zeta 0.01: 5.2e-5).
+    (``f_se_hz`` / f, ``zeta_se`` / zeta), never less than the sweeps' floors in the same convention
+    (`jointcal.measure.testkinds.ringdown.window_scales`, which the calibration's polish weighs windows by).
 
     Returns
     -------
     sigma_f, sigma_zeta : ndarray, shape (len(windows),)
     """
-    f, z = windows["f_hz"].to_numpy(float), windows["zeta"].to_numpy(float)
-    sigma_f = np.maximum(windows["f_se_hz"].to_numpy(float) / f, np.abs(z) * np.radians(floor_deg))
-    sigma_z = np.maximum(windows["zeta_se"].to_numpy(float) / np.abs(z), 10 ** (floor_db / 20) - 1)
-    return sigma_f, sigma_z
+    return window_scales(*(windows[c].to_numpy(float) for c in ("f_hz", "zeta", "f_se_hz", "zeta_se")),
+                         floor_db=floor_db, floor_deg=floor_deg)
 
 
 def compare_decay(meas: pd.DataFrame, sim: pd.DataFrame, *, floor_db: float = 0.05,

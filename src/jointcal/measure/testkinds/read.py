@@ -39,7 +39,7 @@ from ..modes import mode_name
 from ..receptance import Receptance
 from ..ringdown import decay_start, ringdown_backbone
 from .registry import READOUT_RULES, methods
-from .ringdown import METHOD as WINDOWS, MIN_DECAY_S
+from .ringdown import METHOD as WINDOWS, MIN_DECAY_S, SE_COLUMNS
 
 __all__ = ["other_kinds_modal", "backbone_table", "read_test_run", "receptance_row", "row_receptance",
            "BACKBONE_COLUMNS", "RECEPTANCE_COLUMNS", "MIN_DECAY_S", "NEAR"]
@@ -217,8 +217,10 @@ def other_kinds_modal(rows: list[dict], records: dict, kind: str, swept: dict[st
         row, rid = r["row"], r["row"]["run_id"]
         w = r["windows"]
         if w is not None and len(w):
-            points += [{"run_id": rid, "mode": r["mode"], "test": WINDOWS, "q_in": q, "f_hz": f, "zeta": z}
-                       for q, f, z in zip(w["q_in"], w["f_hz"], w["zeta"])]
+            se = {c: w[c] for c in SE_COLUMNS if c in w}  # each window's length and own standard errors
+            points += [{"run_id": rid, "mode": r["mode"], "test": WINDOWS, "q_in": q, "f_hz": f, "zeta": z,
+                        **{c: float(v.iloc[i]) for c, v in se.items()}}
+                       for i, (q, f, z) in enumerate(zip(w["q_in"], w["f_hz"], w["zeta"]))]
         out = {**{k: row.get(k) for k in IDENTITY}, level: row.get(level), "mode": r["mode"],
                "test": row.get("test"), "mode_peak_hz": r["f_guess"]}
         _, readout, flags, pts = READOUT_RULES[run_test_kind(row).name].read(r)
@@ -260,7 +262,10 @@ def row_receptance(row) -> dict | None:
 def backbone_table(modal: pd.DataFrame, points: list[dict]) -> pd.DataFrame:
     """backbone.csv: every sweep row's read-out (``q_in``, ``f_res_hz``, ``zeta_res``) and the other kinds' points.
 
-    The rows flagged ``unusable`` are left out; the order is the modal table's runs, windows in time order.
+    The rows flagged ``unusable`` are left out; the order is the modal table's runs, windows in time order. Where
+    any point carries its length and standard errors (a ring-down's windows: ``window_s``, ``f_se_hz``,
+    ``zeta_se``, `jointcal.measure.testkinds.ringdown.SE_COLUMNS`) the table has those columns too, empty for the other rows (a
+    campaign of sweeps keeps its six).
     """
     usable = ~modal["flags"].fillna("").str.contains(UNUSABLE)
     method = modal["f_res_method"] if "f_res_method" in modal else pd.Series("", index=modal.index)
@@ -269,7 +274,8 @@ def backbone_table(modal: pd.DataFrame, points: list[dict]) -> pd.DataFrame:
     out = [pd.DataFrame({"run_id": rows["run_id"], "mode": rows["mode"], "test": DEFAULT, "q_in": rows["q_in"],
                          "f_hz": rows["f_res_hz"], "zeta": rows["zeta_res"]})]
     bad = set(modal.loc[~usable, "run_id"])
-    out.append(pd.DataFrame([p for p in points if p["run_id"] not in bad], columns=BACKBONE_COLUMNS))
+    se = [c for c in SE_COLUMNS if any(c in p for p in points)]  # windows' lengths and errors, where read
+    out.append(pd.DataFrame([p for p in points if p["run_id"] not in bad], columns=BACKBONE_COLUMNS + se))
     table = pd.concat(out, ignore_index=True)
     order = {r: i for i, r in enumerate(dict.fromkeys(modal["run_id"]))}
     key = table["run_id"].map(order)
