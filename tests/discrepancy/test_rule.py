@@ -57,7 +57,7 @@ def test_decide_quotes_the_clauses_of_its_rule_that_decided():
     alike = [_scored("baseline", 9.0), _scored("sensor_gain", 6.0), _scored("channel_delay", 6.2),
              _scored("sensor_gain+channel_delay", 5.9)]
     assert decide(alike).applied[1:] == (CLAUSES["single"], CLAUSES["pair"], CLAUSES["unexplained"])
-    assert all(c in RULE for c in CLAUSES.values()) and RULE.endswith(CLAUSES["name_not_confirmed"])
+    assert all(c in RULE for c in CLAUSES.values()) and RULE.endswith(CLAUSES["name_misses"])
     assert confirm("none", "high", 2.0, 1.9)[2] in CLAUSES and confirm("a", "high", 6.0, 6.5)[2] in CLAUSES
 
 
@@ -82,3 +82,7 @@ def test_the_time_simulation_has_the_last_word():
     assert confirm("none", "high", 2.5, 2.2) == ("unexplained", "low", "none_contradicted")
     assert confirm("sensor_gain", "high", 6.0, 1.1) == ("sensor_gain", "high", None)
     assert confirm("sensor_gain", "high", 6.0, 6.5) == ("sensor_gain", "low", "name_not_confirmed")
+    # E falls but the recalibrated model still misses: the name holds, high no longer
+    assert confirm("quadratic_damping", "high", 6.26, 3.51) == ("quadratic_damping", "medium", "name_misses")
+    assert confirm("quadratic_damping", "medium", 6.26, 3.51) == ("quadratic_damping", "medium", None)
+    assert confirm("quadratic_damping", "high", 6.26, 1.9) == ("quadratic_damping", "high", None)

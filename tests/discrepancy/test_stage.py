@@ -210,3 +210,17 @@ def test_where_nothing_is_named_the_baseline_is_revalidated_with_its_own_drive(m
     assert all(r.gain == own for r in seen["recalibrated_runs"])
     assert all(r["drive_gain"] == own for r in seen["revalidated_rows"])
     assert d["voltage_drive"]["revalidated_with"] == "the baseline's slope"
+
+
+def test_a_pairs_fingerprints_name_what_both_effects_share_once():
+    """The verdicts of a record whose 2nd harmonic dominates (`fingerprints.verdicts`): the even-harmonic sentence
+    stands against every effect; a pair lists it once, and each effect's own 'not seen' sentence once."""
+    from jointcal.discrepancy.fingerprints import verdicts
+    from jointcal.discrepancy.stage import fingerprint_words
+
+    ver = verdicts({"h2_ratio": 0.011, "h3_ratio": 0.001}, 0.05, 1e-3)
+    one = fingerprint_words(("neighbour_mode",), ver, "against")
+    pair = fingerprint_words(("neighbour_mode", "channel_delay"), ver, "against")
+    even = [w for w in pair if w.startswith("even harmonics dominate")]
+    assert len(even) == 1 and any(w.startswith("even harmonics") for w in one)
+    assert len(pair) == len(set(pair)) == len(set(ver["neighbour_mode"]["against"] + ver["channel_delay"]["against"]))

@@ -45,6 +45,9 @@ def test_the_words_never_contradict_the_verdict():
     worse = diagnosis_markdown(_diagnosis("sensor_gain", 6.0, 6.5, 7.0, 0.14, [("sensor_gain", 1.9)],
                                           confidence="low", note="name_not_confirmed"))
     assert "does not fall" in worse and "does not confirm" in worse and "(confidence low)" in worse
+    part = diagnosis_markdown(_diagnosis("quadratic_damping", 6.26, 3.51, 7.0, 0.14, [("quadratic_damping", 1.9)],
+                                         confidence="medium", note="name_misses"))
+    assert "falls from 6.26 to 3.51" in part and "part of the gap" in part and "(confidence medium)" in part
 
 
 def test_the_words_say_when_and_why_a_voltage_drives_slope_is_not_taken():

@@ -129,3 +129,17 @@ def test_several_runs_of_one_model_equal_one_run_at_a_time():
         assert T.shape == alone.shape == (P, f.size)
         assert np.array_equal(T, alone)
         assert np.all(np.isfinite(T))
+
+
+def test_the_run_in_leaves_the_start_states_error_at_its_tolerance():
+    """`run_in`'s closed form: the quasi-steady start's error eta / (2 pi x^2), decayed over the x / eta decay
+    times the sweep takes to reach the resonance, is the tolerance at the returned x (to the grid's 0.7%), SPAN
+    for slow sweeps, and grows with eta."""
+    from jointcal.models.swept_integrated import SPAN, START_TOL, run_in
+
+    g = lambda x, eta: eta / (2 * np.pi * x**2) * np.exp(-2 * np.pi * x / eta)  # noqa: E731
+    assert run_in(0.5) == run_in(4.0) == SPAN and g(SPAN, 4.0) <= START_TOL
+    xs = [run_in(eta) for eta in (10.0, 100.0, 500.0)]
+    assert xs[0] < xs[1] < xs[2]
+    for eta, x in zip((10.0, 100.0, 500.0), xs):
+        assert g(x, eta) <= START_TOL < g(x / 1.007, eta)

@@ -51,6 +51,8 @@ CLAUSES: dict[str, str] = {
                           "becomes unexplained."),
     "name_not_confirmed": (f"A name whose time-domain E does not fall, from above {NONE_E}, keeps confidence "
                            "low."),
+    "name_misses": (f"A name whose recalibrated model's time-domain E stays above {HIGH_SCORE:g} is held at most "
+                    "medium: it closes part of the gap, not all of it."),
 }
 RULE = " ".join(CLAUSES.values())
 
@@ -145,12 +147,15 @@ def confirm(effect: str, confidence: str, e_before: float, e_after: float) -> tu
     e_before, e_after : the time-domain E of the calibrated model and of the decided model
     recalibrated. 'none' with both above `NONE_E` is contradicted (-> 'unexplained', note
     'none_contradicted'); a name whose E does not fall, from above `NONE_E`, is not confirmed
-    (confidence 'low', note 'name_not_confirmed').
+    (confidence 'low', note 'name_not_confirmed'); a name whose E falls but stays above `HIGH_SCORE`
+    is held at most 'medium' (note 'name_misses').
     """
     if effect == "none" and min(e_before, e_after) > NONE_E:
         return "unexplained", "low", "none_contradicted"
     if effect not in ("none", "unexplained") and e_after >= e_before and e_before > NONE_E:
         return effect, "low", "name_not_confirmed"
+    if effect not in ("none", "unexplained") and e_after > HIGH_SCORE and confidence == "high":
+        return effect, "medium", "name_misses"
     return effect, confidence, None
 
 

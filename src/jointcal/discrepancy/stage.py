@@ -101,8 +101,14 @@ def _candidate_json(s, space, m, ver, scales) -> dict:
     return {"name": s.name, "effects": list(c.effects), "held_out_score": s.score, "E_fit": s.fit.E,
             "held_out_E_per_level": s.held_out, "effect_parameters": eff,
             "joint_parameters": c.grown.named(s.fit.theta, PARAMS),
-            "fingerprints_for": [w for e in c.effects for w in ver[e]["for"]],
-            "fingerprints_against": [w for e in c.effects for w in ver[e]["against"]], "seconds": s.seconds}
+            "fingerprints_for": fingerprint_words(c.effects, ver, "for"),
+            "fingerprints_against": fingerprint_words(c.effects, ver, "against"), "seconds": s.seconds}
+
+
+def fingerprint_words(effects: Sequence[str], ver: Mapping[str, Mapping[str, list]], side: str) -> list[str]:
+    """The fingerprints 'for' or 'against' a candidate of these effects (`fingerprints.verdicts`), each once: a
+    pair's two effects share those that point outside the library."""
+    return list(dict.fromkeys(w for e in effects for w in ver[e][side]))
 
 
 def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFrame, best: Mapping,

@@ -21,7 +21,7 @@ from collections.abc import Mapping
 
 from ..effects import EFFECTS
 from .drive import MAX_RELATIVE_SLOPE, refits_slope
-from .rule import FLOOR_HIGH, NONE_E
+from .rule import FLOOR_HIGH, HIGH_SCORE, NONE_E
 
 __all__ = ["diagnosis_markdown"]
 
@@ -88,6 +88,9 @@ def _named(d: Mapping, E0: float, E1: float) -> list[str]:
     if d.get("time_domain_check") == "name_not_confirmed":
         lines[-1] += (" The time simulation does not confirm the name, so its confidence is low: check the "
                       "advice above before acting on it.")
+    elif d.get("time_domain_check") == "name_misses":
+        lines[-1] += (f" That is still above {HIGH_SCORE:g}: the effect explains part of the gap, not all of it, so "
+                      "its confidence is at most medium; something else is missing too.")
     elif E0 <= NONE_E:
         lines[-1] += (f" The calibrated model was already within the 'none' threshold ({NONE_E}) in the time "
                       "domain; the effect shows in how the held-out runs are predicted, not in the overall E.")

@@ -2,7 +2,8 @@
 
 `swept_transmissibility` integrates the first-order slow flow of `jointcal.models.swept` by
 RK4 (`_envelope_kernel.slow_flow`) through the resonance, from the quasi-steady state at
-x = -`SPAN` (x = (f / f_res - 1) / zeta, in sweep order) to x = max(`SPAN`, 1.2 eta), and
+x = -`run_in` (x = (f / f_res - 1) / zeta, in sweep order; `SPAN` for eta up to about 4, further back for a
+faster sweep, whose start state has less time to die out) to x = max(`SPAN`, 1.2 eta), and
 averages it over each frame's Hann window as the envelopes are (T = <R> / <A>); other
 frames take `quasi_steady`. A drive with a phase (`SweepDrive.phase_rad`) is integrated as its
 complex envelope A = |A| e^{i psi}: the forcing F A - i F' A' - (i/2) alpha F'' A with
@@ -19,7 +20,7 @@ from .envelope import GAUSS_NODES, GAUSS_WEIGHTS, batch_field, joint_terms
 from .structure import MinistackModel
 from .swept import SweepDrive, _channel, _derivs, _quasi_steady, sweep_eta
 
-__all__ = ["swept_transmissibility", "ETA_MIN", "SPAN"]
+__all__ = ["swept_transmissibility", "run_in", "ETA_MIN", "SPAN", "START_TOL"]
 
 ETA_MIN = 0.02  # below this eta the first-order quasi-steady envelope is as close as the integrated one
 SPAN = 3.0  # integrated from x = -SPAN through the resonance, half-power half-widths
