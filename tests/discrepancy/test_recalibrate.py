@@ -86,3 +86,29 @@ def test_the_posterior_of_joint_plus_sensor_gain_covers_the_truth(tmp_path):
                                                              f"[{q.at[p, 'q05']:.4g}, {q.at[p, 'q95']:.4g}]"
     # the gain is measured, not left to its prior [0.5, 2]: its interval is within a few percent
     assert q.at["gain", "q95"] / q.at["gain", "q05"] < 1.1
+
+
+def test_ring_down_fits_the_data_do_not_tell_apart_keep_the_one_without_a_knee_on_the_top_window():
+    """`recalibrate._chosen` on two fits of the Ministack's joint: one with its macroslip onset phi_max (eq. 3.7,
+    computed here from its Fs, KT, chi, beta) just under the top window's start, the other all in microslip, E 0.90
+    and 0.92. Over 40 residuals -2 ln L differs by 40 (0.92^2 - 0.90^2) / 1 = 1.5 < 3.84: the microslip fit is
+    kept; over 400 (15) the data tell them apart and the lower E wins. Sweeps' runs (no `q_top`): the lowest E."""
+    from types import SimpleNamespace
+
+    from jointcal.discrepancy.fit import Fit
+    from jointcal.discrepancy.recalibrate import _chosen
+    from jointcal.models.iwan import derived
+    from tests._support.envelopes import M, SPACE, TRUTH
+
+    c = candidate("baseline", SPACE, M)
+    slip = TRUTH.copy()
+    phi = derived(*TRUTH[:4])[0]
+    top = np.array([0.5, 0.8, 1.02]) * phi  # the truth's onset just under the top window's start
+    knee = Fit("baseline", TRUTH, 0.90, np.eye(6), 1)
+    slip[0] = 3 * TRUTH[0]  # three times the slip force: phi_max three times as far
+    assert derived(*slip[:4])[0] > top.max()
+    micro = Fit("baseline", slip, 0.92, np.eye(6), 1)
+    runs = [SimpleNamespace(q_in=top / 1.1, q_top=top)]
+    assert _chosen([knee, micro], c, runs, 40) is micro
+    assert _chosen([knee, micro], c, runs, 400) is knee
+    assert _chosen([knee, micro], c, [SimpleNamespace()], 40) is knee

@@ -65,7 +65,8 @@ class DecayRun:
     run's level in its own unit; band : the amplitude band's label ('' for the whole run); record : the run's
     measured record (time_s, reference, response_accel_g; g), for its simulated read-out
     (`decay_readout`), None without it; read : the record's `measured_read` (the measured windows the
-    validation compares with), read once.
+    validation compares with), read once; q_top : the amplitude at each window's start, in (a window reads
+    from there down to q_in and beyond; None where the window lengths are not known).
     """
 
     q_in: NDArray[np.float64]
@@ -78,6 +79,7 @@ class DecayRun:
     band: str = ""
     record: pd.DataFrame | None = field(default=None, compare=False, repr=False)
     read: Mapping | None = field(default=None, compare=False, repr=False)
+    q_top: NDArray[np.float64] | None = field(default=None, compare=False, repr=False)
 
     @property
     def run_id(self) -> str:
@@ -133,6 +135,18 @@ def _points(backbone: pd.DataFrame, modal: pd.DataFrame, rows: Sequence[Mapping]
     return out
 
 
+def _window_tops(q: NDArray, f: NDArray, z: NDArray, windows: pd.DataFrame | None) -> NDArray | None:
+    """The amplitude at the start of the window read at each q (in): q exp(pi f zeta L), the window length L
+    interpolated in log q along the windows read again from the record; None without their lengths."""
+    if windows is None or not {"q_in", "window_s"} <= set(windows.columns):
+        return None
+    w = windows[(windows["q_in"] > 0) & np.isfinite(windows["window_s"])].sort_values("q_in")
+    if w.empty:
+        return None
+    L = np.interp(np.log(q), np.log(w["q_in"].to_numpy(float)), w["window_s"].to_numpy(float))
+    return q * np.exp(np.pi * f * z * L)
+
+
 def _own_se(q: NDArray, f: NDArray, z: NDArray, windows: pd.DataFrame | None) -> tuple[NDArray, NDArray] | None:
     """The read-out's relative standard errors of f and zeta at amplitudes q (interpolated in log q along the
     windows read again from the record), None without them."""
@@ -185,6 +199,7 @@ def decay_runs(backbone: pd.DataFrame, modal: pd.DataFrame, rows: Sequence[Mappi
     for row, p in pts:
         q, f, z = (p[c].to_numpy(float) for c in ("q_in", "f_hz", "zeta"))
         own = _own_se(q, f, z, (se or {}).get(str(row["run_id"])))
+        top = _window_tops(q, f, z, (se or {}).get(str(row["run_id"])))
         f_se, z_se = own if own is not None else (np.nan_to_num(sf) * f, np.nan_to_num(sz) * z)
         s_f, s_z = scales(pd.DataFrame({"f_hz": f, "zeta": z, "f_se_hz": f_se, "zeta_se": z_se}), floor_db=floor_db,
                           floor_deg=floor_deg)
@@ -195,7 +210,7 @@ def decay_runs(backbone: pd.DataFrame, modal: pd.DataFrame, rows: Sequence[Mappi
             lo, hi = np.exp(edges[k]), np.exp(edges[k + 1])
             out.append(DecayRun(q[i], f[i], z[i], s_f[i], s_z[i], row, float(row[col]) if col else float("nan"),
                                 f"q {lo:.2g} to {hi:.2g} in", (records or {}).get(str(row["run_id"])),
-                                reads.get(str(row["run_id"]))))
+                                reads.get(str(row["run_id"])), None if top is None else top[i]))
     return out
 
 

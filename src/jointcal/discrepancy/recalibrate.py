@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from ..calibrate.fit import search
+from ..calibrate.fit import pick_polished, search
 from ..calibrate.ga import GAOptions
 from ..posterior.likelihood import ResidualPosterior
 from ..posterior.sampler import sample_ball
@@ -78,6 +78,23 @@ def _posterior(obj: Objective, at: Fit, temperature: float) -> ResidualPosterior
                              temperature, np.clip(space.to_unit(at.theta), 0.0, 1.0), space.free_mask(HELD))
 
 
+def _chosen(fits: Sequence[Fit], c: Candidate, runs: Sequence, n_res: int) -> Fit:
+    """The lowest E, or, for ring-down windows that know where they start (`DecayRun.q_top`), the calibration's
+    rule (`jointcal.calibrate.fit.pick_polished`): among fits the data do not tell apart (-2 ln L = n_res E^2 / T,
+    T as the chain's, within chi-square(1)'s 95% of the lowest), the one with the fewest windows reaching its
+    macroslip onset: a knee placed on the top window fits the backbone there, not the ring-down read through it
+    (a dwell's point counts at its own amplitude)."""
+    tops = [getattr(r, "q_top", None) for r in runs]
+    if all(t is None for t in tops):  # sweeps' frames, or windows of unknown length
+        return min(fits, key=lambda f: f.E)
+    tops = [r.q_in if t is None else t for r, t in zip(runs, tops)]  # a dwell's point: its own amplitude
+    E = np.array([f.E for f in fits])
+    chi2 = n_res * E**2 / max(float(np.min(E)) ** 2, 1.0)
+    th = np.array([f.theta for f in fits])
+    beyond = np.sum(np.concatenate(tops)[None, :] >= c.grown.phi_max(th)[:, None], axis=1)
+    return fits[pick_polished(chi2, beyond)]
+
+
 def recalibrate(c: Candidate, runs: Sequence[RunEnvelope], starts: Sequence[Fit], *, seed: int = 2017,
                 population: int = 48, generations: int = 30, walkers: int = 32, steps: int = 800,
                 max_nfev: int = 50, objective=Objective) -> Recalibration:
@@ -95,7 +112,7 @@ def recalibrate(c: Candidate, runs: Sequence[RunEnvelope], starts: Sequence[Fit]
                         seed=seed)
     ga = search(lp.misfit_unit, c.grown, options, free=lp.free, at=lp.at, init=init)
     pol = obj.fit(lp.physical(ga.best[None])[0], starts=1, max_nfev=max_nfev, refresh=1)
-    best = min([pol, *starts], key=lambda f: f.E)
+    best = _chosen([pol, *starts], c, runs, obj.residuals(pol.theta).size)
     lp = _posterior(obj.at(best.theta), best, max(best.E**2, 1.0))  # the chain holds beta at the chosen fit's value
     # the Gauss-Newton width, within [0.003, 0.01] of the unit cube: a flat direction must not
     # start as a point, or the ensemble explores it too slowly
