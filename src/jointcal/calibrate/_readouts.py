@@ -40,7 +40,7 @@ import pandas as pd
 from ..measure.testkinds import estimator_of
 from ..measure.testkinds.dwell import STEADY
 from ..measure.testkinds.ringdown import METHOD as WINDOWS
-from ..measure.testkinds.ringdown import SE_COLUMNS, window_scales
+from ..measure.testkinds.ringdown import SE_COLUMNS, window_scales, window_top
 
 __all__ = ["expand", "QUAD"]
 
@@ -71,7 +71,7 @@ def _scales(w: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         return (np.full(len(w), np.nan),) * 3
     length, f_se, z_se = (pd.to_numeric(w[c], errors="coerce").to_numpy(float) for c in SE_COLUMNS)
     q, f, z = (w[c].to_numpy(float) for c in _VALUES)
-    return (*window_scales(f, z, f_se, z_se), q * np.exp(np.pi * f * z * length))
+    return (*window_scales(f, z, f_se, z_se), window_top(q, f, z, length))
 
 
 def expand(rows: pd.DataFrame, backbone: pd.DataFrame, level: np.ndarray, columns: tuple[str, str, str],

@@ -43,7 +43,7 @@ from ..io import level_column, level_unit
 from ..io.contract import UNUSABLE
 from ..io.testkinds import run_test_kind
 from ..measure.testkinds import level_readout
-from ..measure.testkinds.ringdown import METHOD as WINDOWS
+from ..measure.testkinds.ringdown import METHOD as WINDOWS, window_top
 from ..models.free_decay import free_backbone
 from ..validate.decay import scales
 from ..validate.testkinds import measured_read
@@ -136,15 +136,14 @@ def _points(backbone: pd.DataFrame, modal: pd.DataFrame, rows: Sequence[Mapping]
 
 
 def _window_tops(q: NDArray, f: NDArray, z: NDArray, windows: pd.DataFrame | None) -> NDArray | None:
-    """The amplitude at the start of the window read at each q (in): q exp(pi f zeta L), the window length L
+    """The amplitude at the start of the window read at each q (in, `window_top`), the window length
     interpolated in log q along the windows read again from the record; None without their lengths."""
     if windows is None or not {"q_in", "window_s"} <= set(windows.columns):
         return None
     w = windows[(windows["q_in"] > 0) & np.isfinite(windows["window_s"])].sort_values("q_in")
     if w.empty:
         return None
-    L = np.interp(np.log(q), np.log(w["q_in"].to_numpy(float)), w["window_s"].to_numpy(float))
-    return q * np.exp(np.pi * f * z * L)
+    return window_top(q, f, z, np.interp(np.log(q), np.log(w["q_in"].to_numpy(float)), w["window_s"].to_numpy(float)))
 
 
 def _own_se(q: NDArray, f: NDArray, z: NDArray, windows: pd.DataFrame | None) -> tuple[NDArray, NDArray] | None:

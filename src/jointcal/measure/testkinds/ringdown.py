@@ -11,12 +11,19 @@ from numpy.typing import ArrayLike, NDArray
 
 from .readout import Estimator, Readout, ReadoutRule, Refusal
 
-__all__ = ["RULE", "WINDOWS", "METHOD", "MIN_DECAY_S", "SE_COLUMNS", "FLOOR_DB", "FLOOR_DEG", "window_scales"]
+__all__ = ["RULE", "WINDOWS", "METHOD", "MIN_DECAY_S", "SE_COLUMNS", "FLOOR_DB", "FLOOR_DEG", "window_scales", "window_top"]
 
 METHOD = "ringdown"  # its f_res_method, and backbone.csv's ``test`` of every decay window (a dwell's too)
 MIN_DECAY_S = 1.0  # a record this long after the cut holds a ring-down to read (as decay_start asks)
 SE_COLUMNS = ("window_s", "f_se_hz", "zeta_se")  # a window's length (s), standard errors of f (Hz) and zeta
 FLOOR_DB, FLOOR_DEG = 0.05, 0.3  # the sweeps' floors (the validation's defaults, `ValidateSettings`): dB, deg
+
+
+def window_top(q_in: ArrayLike, f_hz: ArrayLike, zeta: ArrayLike, window_s: ArrayLike) -> NDArray[np.float64]:
+    """The amplitude at the start of a window read at q_in (in): q_in exp(pi f zeta L), the decay
+    exp(-2 pi f zeta t) over the half window L / 2 before its centre (f in Hz, L in s)."""
+    q, f, z, L = (np.asarray(v, dtype=float) for v in (q_in, f_hz, zeta, window_s))
+    return q * np.exp(np.pi * f * z * L)
 
 
 def window_scales(f_hz: ArrayLike, zeta: ArrayLike, f_se_hz: ArrayLike, zeta_se: ArrayLike, *,
