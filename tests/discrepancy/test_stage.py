@@ -126,13 +126,13 @@ def _stand_ins(monkeypatch, floor: float, scores: dict[str, float]) -> dict:
                 "baseline_E_refined": 1.0}
         return new, build(new), info
 
-    def score_library(assembly, space, m, runs, theta0, F, settings, joint_starts, clock, say, scales):
+    def score_singles(assembly, space, m, theta0, settings, clock, say, scales, runs):
         out = []
         for name, score in scores.items():
             c = candidate(name, space, m, scales)
             th = c.grown.vector(dict(zip(PARAMS, theta0)), default={p.name: p.start for p in c.effect_params})
             out.append(Scored(name, Fit(name, th, score, 1e-4 * np.eye(c.grown.ndim), 1), score))
-        return out, []
+        return out
 
     def recalibrated(assembly, final, space, m, runs, *args):
         seen["recalibrated_runs"] = runs
@@ -144,7 +144,8 @@ def _stand_ins(monkeypatch, floor: float, scores: dict[str, float]) -> dict:
 
     fp = {"h2_ratio": 0.0, "h3_ratio": 0.0}
     ver = {n: {"for": [], "against": []} for n in scores}
-    for name, fn in {"_usable_runs": usable_runs, "refine_slope": refine_slope, "_score_library": score_library,
+    for name, fn in {"_usable_runs": usable_runs, "refine_slope": refine_slope, "_score_singles": score_singles,
+                     "_add_pairs": lambda *a: (a[9], []),
                      "_recalibrated": recalibrated, "validate_runs": validate_runs,
                      "fast_floor": lambda *a: {"E": floor, "per_level": {}},
                      "_localise": lambda *a: (pd.DataFrame(), fp, ver, None),

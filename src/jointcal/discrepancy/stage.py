@@ -4,10 +4,11 @@
    time simulation of it on the same runs and bins (`floor.fast_floor`).
    A voltage drive: the slope of its modal constant A(w) refit with the baseline on the
    envelope frames (`drive.refine_slope`: the read-out's leaves most of the coil's phase
-   slope out); every later step takes the refined drive. When a candidate scores better
-   than the baseline, the slope is refit with it and the library scored again, and a named
-   model refits it once more before its recalibration (the baseline's misfit moves the
-   slope it finds). Not where the floor is above the repeat scatter (`rule.FLOOR_HIGH`): the
+   slope out); every later step takes the refined drive. When a single effect scores better
+   than the baseline, the slope is refit with it and the single effects scored again before
+   forward selection decides whether a second effect is needed; when a pair then scores best,
+   the slope is refit with that pair and the library scored again; a named model refits it
+   once more before its recalibration (the baseline's misfit moves the slope it finds). Not where the floor is above the repeat scatter (`rule.FLOOR_HIGH`): the
    fast model that judges the slope is then further from its record than the slope moves it.
 1. Localise: the baseline (the calibration's optimum, refit on the envelopes) against
    the measured envelopes; residual map and fingerprints (`fingerprints`).
@@ -190,19 +191,32 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
             f"baseline E {drive['baseline_E_read_out']:.2f} -> {drive['baseline_E_refined']:.2f}")
         clock.lap("drive")
     baseline_drive = (gain, runs, rows)  # the drive the baseline refit: kept where no model is named
-    scored, pairs_tried = _score_library(assembly, space, m, runs, theta0, F, settings, joint_starts, clock, say, scales)
+    lib = (assembly, space, m, theta0, settings, clock, say, scales)
+    scored = _score_singles(*lib, runs)
     lead = min(scored, key=lambda s: s.score)
-    if drive is not None and lead.name != "baseline":  # the baseline missed: the slope again with the model that
-        # predicts best, and the library scored again with it (the baseline's misfit moved the slope it found)
+    if drive is not None and lead.name != "baseline":  # the baseline missed: the slope again with the single effect
+        # that predicts best, and the singles scored again with it, before forward selection asks for a second
+        # effect (the baseline's misfit moved the slope it found; a pair judged on that slope is partly the slope's)
         gain, runs, again = refine_slope(candidate(lead.name, space, m, scales), lead.fit.theta, gain, build,
                                          max_nfev=settings.max_nfev)
         rows = [{**r, "drive_gain": gain} for r in rows]
         drive["with_best"] = {"model": lead.name, **again}
-        say(f"{assembly}: the voltage drive's slope refit with {lead.name}, which scores best: "
+        say(f"{assembly}: the voltage drive's slope refit with {lead.name}, the single effect that scores best: "
+            f"{complex(*again['relative_slope_refined']):.3f}; the single effects scored again with it")
+        clock.lap("drive")
+        scored = _score_singles(*lib, runs)
+    scored, pairs_tried = _add_pairs(*lib, runs, scored, F, joint_starts)
+    lead = min(scored, key=lambda s: s.score)
+    if drive is not None and len(effects_of(lead.name)) > 1:  # a pair predicts best: the slope with it, and the
+        # library (singles and pairs) scored again
+        gain, runs, again = refine_slope(candidate(lead.name, space, m, scales), lead.fit.theta, gain, build,
+                                         max_nfev=settings.max_nfev)
+        rows = [{**r, "drive_gain": gain} for r in rows]
+        drive["with_pair"] = {"model": lead.name, **again}
+        say(f"{assembly}: the voltage drive's slope refit with {lead.name}, the pair that scores best: "
             f"{complex(*again['relative_slope_refined']):.3f}; the library scored again with it")
         clock.lap("drive")
-        scored, pairs_tried = _score_library(assembly, space, m, runs, theta0, F, settings, joint_starts, clock, say,
-                                             scales)
+        scored, pairs_tried = _add_pairs(*lib, runs, _score_singles(*lib, runs), F, joint_starts)
     base = next(s for s in scored if s.name == "baseline")
     res, fp, ver, outside = _localise(c0, base, runs, mrows, m, sdb)
     decision = decide(scored, outside, floor=F)
@@ -281,15 +295,18 @@ def _usable_runs(assembly, envs, mrows, rows, sdb, sdeg, settings, zeta_min) -> 
     return runs
 
 
-def _score_library(assembly, space, m, runs, theta0, F, settings, joint_starts, clock, say, scales):
-    """Every candidate refit and scored on held-out folds; pairs by forward selection when no single
-    effect closes the gap (the bases refit from the calibration's other valleys first).
-
-    Returns the scored candidates and the pairs tried."""
+def _score_singles(assembly, space, m, theta0, settings, clock, say, scales, runs):
+    """The baseline and every single effect of the library, refit and scored on held-out folds (`score_candidates`)."""
     cands = [candidate("baseline", space, m, scales)] + [candidate(n, space, m, scales) for n in settings.candidates]
     scored = score_candidates(cands, runs, theta0, max_nfev=settings.max_nfev, log=say)
-    base = next(s for s in scored if s.name == "baseline")
     clock.lap("singles")
+    return scored
+
+
+def _add_pairs(assembly, space, m, theta0, settings, clock, say, scales, runs, scored, F, joint_starts):
+    """Pairs by forward selection when no single effect closes the gap (`rule.needs_pairs`; the bases refit from the
+    calibration's other valleys first): the scored candidates with them, and the pairs tried."""
+    base = next(s for s in scored if s.name == "baseline")
     pairs_tried = []
     if needs_pairs(scored, F):
         bases = pair_bases(scored)
@@ -305,8 +322,8 @@ def _score_library(assembly, space, m, runs, theta0, F, settings, joint_starts, 
         say(f"{assembly}: no single effect closes the gap; forward selection tries {len(names)} pairs")
         fits = {s.name: s.fit.theta for s in scored}
         pc = [candidate(n, space, m, scales) for n in names]
-        scored += score_candidates(pc, runs, theta0, max_nfev=2 * settings.max_nfev, log=say, baseline=base,
-                                   starts={n: [fits[effects_of(n)[0]]] for n in names})
+        scored = scored + score_candidates(pc, runs, theta0, max_nfev=2 * settings.max_nfev, log=say, baseline=base,
+                                           starts={n: [fits[effects_of(n)[0]]] for n in names})
         pairs_tried = names
     clock.lap("pairs")
     return scored, pairs_tried
