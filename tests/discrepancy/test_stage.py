@@ -213,6 +213,46 @@ def test_where_nothing_is_named_the_baseline_is_revalidated_with_its_own_drive(m
     assert d["voltage_drive"]["revalidated_with"] == "the baseline's slope"
 
 
+def test_forward_selection_judges_pairs_on_the_best_singles_slope(monkeypatch):
+    """A voltage campaign where the best single effect (joint_settling, 2.9 against the baseline's 8) leaves the gap
+    open on the baseline's slope: the slope is refit with that single and the singles scored again BEFORE forward
+    selection looks for a second effect, and the pairs are judged on runs built with the single's drive (the
+    baseline's slope is bent by what it misses; on the virtual lab's voltage settling campaigns a neighbouring mode
+    then took up the bend). A pair that then leads refits the slope once more, and the library is scored again."""
+    from jointcal.discrepancy import stage
+    from tests._support.beam_runs import beam_space
+
+    seen = _stand_ins(monkeypatch, 0.5, {"baseline": 8.0, "joint_settling": 2.9})
+    order = []
+    singles = stage._score_singles
+
+    def score_singles(*a):
+        order.append(("singles", a[-1][0].gain))
+        return singles(*a)
+
+    def add_pairs(*a):
+        order.append(("pairs", a[8][0].gain))
+        scored = a[9]
+        if len(order) > 3:  # the second forward selection: the pair's drive
+            return scored, []
+        from jointcal.discrepancy.fit import Fit
+        from jointcal.discrepancy.select import Scored
+        lead = min(scored, key=lambda s: s.score)
+        return scored + [Scored("joint_settling+neighbour_mode", Fit("p", lead.fit.theta, 1.0, lead.fit.cov_unit, 1),
+                                1.0)], ["joint_settling+neighbour_mode"]
+
+    monkeypatch.setattr(stage, "_score_singles", score_singles)
+    monkeypatch.setattr(stage, "_add_pairs", add_pairs)
+    rows, modal, best = _voltage_campaign()
+    stage.diagnose("beam", {}, modal, best, [], [], rows, space=beam_space(),
+                   settings=DiscrepancySettings(candidates=("joint_settling", "neighbour_mode")), metric_before=1.2,
+                   frames_before={}, log=lambda s: None)
+    g = [new for _, _, new in seen["refits"]]
+    assert [name for name, *_ in seen["refits"]][:3] == ["baseline", "joint_settling", "joint_settling+neighbour_mode"]
+    assert order[:3] == [("singles", g[0]), ("singles", g[1]), ("pairs", g[1])]  # pairs on the single's slope
+    assert order[3:] == [("singles", g[2]), ("pairs", g[2])]  # and the library again on the pair's
+
+
 def test_a_pairs_fingerprints_name_what_both_effects_share_once():
     """The verdicts of a record whose 2nd harmonic dominates (`fingerprints.verdicts`): the even-harmonic sentence
     stands against every effect; a pair lists it once, and each effect's own 'not seen' sentence once."""
