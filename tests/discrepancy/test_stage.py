@@ -126,7 +126,7 @@ def _stand_ins(monkeypatch, floor: float, scores: dict[str, float]) -> dict:
                 "baseline_E_refined": 1.0}
         return new, build(new), info
 
-    def score_singles(assembly, space, m, theta0, settings, clock, say, scales, runs):
+    def score_singles(assembly, space, m, theta0, settings, clock, say, scales, runs, prev=None):
         out = []
         for name, score in scores.items():
             c = candidate(name, space, m, scales)
@@ -145,7 +145,7 @@ def _stand_ins(monkeypatch, floor: float, scores: dict[str, float]) -> dict:
     fp = {"h2_ratio": 0.0, "h3_ratio": 0.0}
     ver = {n: {"for": [], "against": []} for n in scores}
     for name, fn in {"_usable_runs": usable_runs, "refine_slope": refine_slope, "_score_singles": score_singles,
-                     "_add_pairs": lambda *a: (a[9], []),
+                     "_add_pairs": lambda *a, **k: (a[9], []),
                      "_recalibrated": recalibrated, "validate_runs": validate_runs,
                      "fast_floor": lambda *a: {"E": floor, "per_level": {}},
                      "_localise": lambda *a: (pd.DataFrame(), fp, ver, None),
@@ -226,11 +226,11 @@ def test_forward_selection_judges_pairs_on_the_best_singles_slope(monkeypatch):
     order = []
     singles = stage._score_singles
 
-    def score_singles(*a):
-        order.append(("singles", a[-1][0].gain))
-        return singles(*a)
+    def score_singles(*a, **k):
+        order.append(("singles", a[8][0].gain))
+        return singles(*a, **k)
 
-    def add_pairs(*a):
+    def add_pairs(*a, **k):
         order.append(("pairs", a[8][0].gain))
         scored = a[9]
         if len(order) > 3:  # the second forward selection: the pair's drive

@@ -204,7 +204,7 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
         say(f"{assembly}: the voltage drive's slope refit with {lead.name}, the single effect that scores best: "
             f"{complex(*again['relative_slope_refined']):.3f}; the single effects scored again with it")
         clock.lap("drive")
-        scored = _score_singles(*lib, runs)
+        scored = _score_singles(*lib, runs, prev=scored)
     scored, pairs_tried = _add_pairs(*lib, runs, scored, F, joint_starts)
     lead = min(scored, key=lambda s: s.score)
     if drive is not None and len(effects_of(lead.name)) > 1:  # a pair predicts best: the slope with it, and the
@@ -216,7 +216,8 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
         say(f"{assembly}: the voltage drive's slope refit with {lead.name}, the pair that scores best: "
             f"{complex(*again['relative_slope_refined']):.3f}; the library scored again with it")
         clock.lap("drive")
-        scored, pairs_tried = _add_pairs(*lib, runs, _score_singles(*lib, runs), F, joint_starts)
+        scored, pairs_tried = _add_pairs(*lib, runs, _score_singles(*lib, runs, prev=scored), F, joint_starts,
+                                         prev=scored)
     base = next(s for s in scored if s.name == "baseline")
     res, fp, ver, outside = _localise(c0, base, runs, mrows, m, sdb)
     decision = decide(scored, outside, floor=F)
@@ -295,17 +296,22 @@ def _usable_runs(assembly, envs, mrows, rows, sdb, sdeg, settings, zeta_min) -> 
     return runs
 
 
-def _score_singles(assembly, space, m, theta0, settings, clock, say, scales, runs):
-    """The baseline and every single effect of the library, refit and scored on held-out folds (`score_candidates`)."""
+def _score_singles(assembly, space, m, theta0, settings, clock, say, scales, runs, prev=None):
+    """The baseline and every single effect of the library, refit and scored on held-out folds (`score_candidates`).
+
+    prev : the same candidates scored on the runs before the drive's slope was refit: each is then also refit
+    from its fit there (the slope moved by a few per cent of itself; from the calibration's optimum alone a fit
+    can land in a worse valley than the one it held: on a voltage campaign hiding a cubic, E 1.42 -> 1.77)."""
     cands = [candidate("baseline", space, m, scales)] + [candidate(n, space, m, scales) for n in settings.candidates]
-    scored = score_candidates(cands, runs, theta0, max_nfev=settings.max_nfev, log=say)
+    scored = score_candidates(cands, runs, theta0, max_nfev=settings.max_nfev, log=say, starts=_warm(theta0, prev))
     clock.lap("singles")
     return scored
 
 
-def _add_pairs(assembly, space, m, theta0, settings, clock, say, scales, runs, scored, F, joint_starts):
+def _add_pairs(assembly, space, m, theta0, settings, clock, say, scales, runs, scored, F, joint_starts, prev=None):
     """Pairs by forward selection when no single effect closes the gap (`rule.needs_pairs`; the bases refit from the
-    calibration's other valleys first): the scored candidates with them, and the pairs tried."""
+    calibration's other valleys first): the scored candidates with them, and the pairs tried. prev : as
+    `_score_singles`'s (a pair fitted there is also refit from that fit)."""
     base = next(s for s in scored if s.name == "baseline")
     pairs_tried = []
     if needs_pairs(scored, F):
@@ -322,11 +328,18 @@ def _add_pairs(assembly, space, m, theta0, settings, clock, say, scales, runs, s
         say(f"{assembly}: no single effect closes the gap; forward selection tries {len(names)} pairs")
         fits = {s.name: s.fit.theta for s in scored}
         pc = [candidate(n, space, m, scales) for n in names]
+        before = {s.name: s.fit.theta for s in prev or ()}
         scored = scored + score_candidates(pc, runs, theta0, max_nfev=2 * settings.max_nfev, log=say, baseline=base,
-                                           starts={n: [fits[effects_of(n)[0]]] for n in names})
+                                           starts={n: [fits[effects_of(n)[0]]] + ([before[n]] if n in before else [])
+                                                   for n in names})
         pairs_tried = names
     clock.lap("pairs")
     return scored, pairs_tried
+
+
+def _warm(theta0, prev) -> dict | None:
+    """`score_candidates`' starts: the calibration's optimum and each candidate's fit in `prev` (None: theta0 alone)."""
+    return None if prev is None else {s.name: [theta0, s.fit.theta] for s in prev}
 
 
 def _localise(c0, base, runs, mrows, m, sdb):
