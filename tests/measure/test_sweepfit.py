@@ -174,14 +174,15 @@ def test_the_sensitivity_jacobian_is_the_central_difference_of_the_same_model(mo
     """The misfit's Jacobian by the RK4 step's forward sensitivities against a Richardson-extrapolated central
     difference of the misfit itself (the same discrete model, integrated apart by `rotating_mode`), column by
     column, at an amplitude-dependent point (every shape coefficient nonzero) with the start state fitted: all
-    22 parameters (a voltage: complex constant and slope) or the 14 of a fixed phase. The amplitude limits are
+    22 parameters (a voltage: complex constant and slope) or the 15 of a fixed phase (with the channels' phase,
+    `PHASE`, freed). The amplitude limits are
     widened so that no finite-difference step crosses a kink of the held ends. The response the sensitivity
     kernel integrates is the plain kernel's, to the last bit."""
     from dataclasses import replace
 
     from jointcal.measure._rotating import demodulate, passage, rotating_mode
     from jointcal.measure._rotating_sensitivity import rotating_mode_sensitivity
-    from jointcal.measure._sweep_problem import NP, Problem
+    from jointcal.measure._sweep_problem import NP, PHASE, Problem
 
     f0, zeta, m = 100.0, 0.015, 1.0 / G
     model = MinistackModel(m=m, k=m * (2 * np.pi * f0) ** 2, zeta_v=zeta)
@@ -191,7 +192,7 @@ def test_the_sensitivity_jacobian_is_the_central_difference_of_the_same_model(mo
     prob = Problem.build(passage(sig, 0.15, 0.02, 6.0, True), f0, zeta, 0.15, modal_phase, 0.01, 0.3, 0.3)
     prob = replace(prob, l_lo=-40.0, l_hi=5.0)
     assert prob.ps.free_start
-    free = prob.free_all
+    free = prob.free_all if modal_phase is None else np.union1d(prob.free_all, [PHASE])
     p = np.zeros(NP)
     p[[0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 15]] = [0.004, -0.1, -0.01, -0.002, 0.1, 0.01, 1.1, 0.2, 0.4, 0.05, -0.03,
                                                    -3e-4]
