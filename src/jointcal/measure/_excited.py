@@ -16,7 +16,8 @@ from .peaks import envelope
 from .frf import frf_flags, quadrature_ok, zeta_at_quadrature
 from .sweepfit import baseband, fit_swept_mode
 
-__all__ = ["sweep_estimate", "backbone_estimate", "excited_readout", "band_envelope_peak", "modal_constant"]
+__all__ = ["sweep_estimate", "backbone_estimate", "excited_readout", "band_envelope_peak", "modal_constant",
+           "channel_lag_text"]
 
 ZETA_MAX = 0.5  # a fitted damping ratio at or above this is no mode
 SWEEP_FRAME = 0.05  # a swept-mode fit more than this fraction off the frequency it was fitted in is off its mode
@@ -45,7 +46,7 @@ def excited_readout(env_out, fit, sweep, why, flags, kind, f_bb, z_bb, rate_hz_p
         q_peak = band_envelope_peak(record, row, kind, sweep.f_hz)
         env_out["sweep_note"] = "; ".join(filter(None, (
             "the record began with the mode already moving: its start state fitted" if sweep.start_fitted else "",
-            sweep.coil_text())))
+            sweep.coil_text(), channel_lag_text(sweep) if kind == "force" else "")))
         flags += ["sweep_truncated"] * sweep.ringing_end
         return dict(f_res_hz=sweep.f_hz, f_res_method="sweep_fit", q_in=sweep.q_in, zeta_res=sweep.zeta,
                     q_peak_in=q_peak, eta=rate_hz_per_s / (sweep.f_hz * sweep.zeta) ** 2)
@@ -66,6 +67,17 @@ def excited_readout(env_out, fit, sweep, why, flags, kind, f_bb, z_bb, rate_hz_p
         flags.append(UNUSABLE)
     q_peak = band_envelope_peak(record, row, kind, f_res)
     return dict(f_res_hz=f_res, f_res_method=method, q_in=q_peak, zeta_res=zeta, q_peak_in=q_peak, eta=eta)
+
+
+def channel_lag_text(sweep) -> str:
+    """A force's read-out whose modal constant took a phase (`jointcal.measure.sweepfit`: the response channel
+    lags the force channel), in words; empty where A stayed real."""
+    a = complex(sweep.modal_constant)
+    if not (np.isfinite(a) and a.imag != 0.0):
+        return ""
+    lag = -float(np.angle(a))
+    return (f"the response channel lags the force by {np.degrees(lag):.1f} deg at the mode (a delay of "
+            f"{lag / (2 * np.pi * sweep.f_hz) * 1e6:.0f} us, if a delay): A's phase fitted, the model driven through |A|")
 
 
 def band_envelope_peak(record: pd.DataFrame | None, row: dict, kind: str, f_hz: float,

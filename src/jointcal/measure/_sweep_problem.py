@@ -17,9 +17,11 @@ from ._rotating import Passage, rotating_mode
 from ._rotating_sensitivity import N_DIRECTIONS, rotating_mode_sensitivity
 from ._sweep_starts import starts as _starts
 
-__all__ = ["Problem", "fit_from_starts", "earned_terms"]
+__all__ = ["PHASE", "Problem", "fit_from_starts", "earned_terms", "earns"]
 
 
+PHASE = 7  # with a fixed phase (a force): p[7], A's part in quadrature with the fixed phase (A = a_abs (p[6] + i p[7])
+# e^{i phase}): 0, or fitted where the channels' phase earns its place (`sweepfit.fit_swept_mode`)
 NP = 24  # parameters: the mode's 18, its start state's 4 where the record begins in motion, a coil's 2
 X_SCALE = np.array([1e-3, 0.1, 0.01, 0.01, 0.2, 0.2, 0.1, 0.1, 0.2, 0.5, 0.5, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01,
                     0.05, 0.05, 0.05, 0.05, 0.05, 0.01])
@@ -90,7 +92,8 @@ class Problem:
         p = np.zeros(NP)
         p[free] = pf
         W0, a_abs, zeta0 = self.ps.sig.W0, self.a_abs, self.zeta0
-        a = p[6] * self.rot if self.fixed else p[6] + 1j * p[7]
+        a = (p[6] + 1j * p[7]) * self.rot if self.fixed else p[6] + 1j * p[7]  # fixed: p[7] (`PHASE`) 0 unless
+        # freed (a response channel that lags the force: A = |A| e^{-i W0 tau} at the mode)
         mode = np.array([W0**2 * np.exp(2 * p[0]), 2 * zeta0 * W0 * np.exp(p[1]), p[2], p[3], p[4], p[5],
                          a.real * a_abs, a.imag * a_abs, p[8], p[9] * a_abs, p[10] * a_abs, p[15]])
         if self.coil is not None:
@@ -206,7 +209,8 @@ class Problem:
         t[0, 0], t[1, 1] = 2.0, 1.0  # ln Omega_ref^2 = ln W0^2 + 2 p[0]; ln D_ref = const + p[1]
         t[2, 2], t[3, 3], t[4, 4], t[5, 5], t[8, 8], t[11, 15] = 1.0, 1.0, 1.0, 1.0, 1.0, 1.0
         t[6, 6], t[7, 6] = (a_abs * self.rot.real, a_abs * self.rot.imag) if self.fixed else (a_abs, 0.0)
-        t[7, 7], t[9, 9], t[10, 10] = (0.0 if self.fixed else a_abs), a_abs, a_abs
+        t[6, 7], t[7, 7] = (-a_abs * self.rot.imag, a_abs * self.rot.real) if self.fixed else (0.0, a_abs)
+        t[9, 9], t[10, 10] = a_abs, a_abs
         if self.ps.free_start:
             t[12, 18], t[13, 19], t[14, 20], t[15, 21] = self.q_ref, self.q_ref, qw, qw
         if self.coil is not None:
@@ -240,15 +244,17 @@ class Problem:
 
 
 def fit_from_starts(prob: Problem, free: NDArray, f0: float, zeta0: float):
-    """The best least-squares solution from `jointcal.measure._sweep_starts.starts`' start values (lazily: a good fit ends the scan)."""
+    """The best least-squares solution from `jointcal.measure._sweep_starts.starts`' start values (lazily: a good
+    fit ends the scan). A fixed phase freed (`PHASE` in `free`): the starts' modal constants complex."""
     s = prob.ps.sig
     best, rel = None, np.inf
+    real = prob.fixed and PHASE not in free
     for f_s, z_s, a_s, b0_s, b1_s, b2_s in _starts(s.R, s.Rd, s.Rm, s.Rdm, s.Rdd, s.Acc, prob.ps.sel, s.h, s.W0, f0,
-                                                   zeta0, prob.fixed, prob.rot):
+                                                   zeta0, real, prob.rot):
         p0 = np.zeros(NP)
         p0[:2] = np.log(f_s / f0), np.log(z_s * f_s / (zeta0 * f0))
         a_s = a_s / prob.a_abs / prob.rot
-        p0[6], p0[7], p0[8] = a_s.real, (0.0 if prob.fixed else a_s.imag), 0.5
+        p0[6], p0[7], p0[8] = a_s.real, (0.0 if real else a_s.imag), 0.5
         b = prob.b_abs
         p0[11:15] = (b0_s.real / b, b0_s.imag / b, b1_s.real / b, b1_s.imag / b)
         p0[16:18] = (b2_s.real / b, b2_s.imag / b)
@@ -258,6 +264,14 @@ def fit_from_starts(prob: Problem, free: NDArray, f0: float, zeta0: float):
         if rel < 0.02:  # a good fit: no more starts
             break
     return best
+
+
+def earns(prob: Problem, sol_more, sol_less, k: int, factor: float) -> bool:
+    """Whether a solution with k more parameters earns them: the Bayesian information criterion of the misfit (half
+    the samples counted: the low-passed envelopes are correlated over two) and its sum of squares cut by `factor`."""
+    n_eff = prob.n_res / 2
+    rss_more, rss_less = (float(np.sum(x.fun[:prob.n_res] ** 2)) for x in (sol_more, sol_less))
+    return bool(rss_more > 0 and rss_less > factor * rss_more and n_eff * np.log(rss_less / rss_more) > k * np.log(n_eff))
 
 
 def earned_terms(prob: Problem, best, free: NDArray, frequency_curvature: str, earn: float):
@@ -272,17 +286,13 @@ def earned_terms(prob: Problem, best, free: NDArray, frequency_curvature: str, e
     the misfit by a factor 1.13 and put q_in's frequency +0.21% off, +0.09% without; a second
     mode's line cuts it 3.6-90x).
     """
-    n_eff = prob.n_res / 2
-
     def refit(sol, old, new):
         p_now = np.zeros(NP)
         p_now[old] = sol.x
         return prob.solve(p_now[new], new, 60)
 
-    def better(sol_more, sol_less, k, factor):  # do k more parameters earn their place?
-        rss_more, rss_less = (float(np.sum(x.fun[:prob.n_res] ** 2)) for x in (sol_more, sol_less))
-        return (rss_more > 0 and rss_less > factor * rss_more
-                and n_eff * np.log(rss_less / rss_more) > k * np.log(n_eff))
+    def better(sol_more, sol_less, k, factor):
+        return earns(prob, sol_more, sol_less, k, factor)
 
     curved = np.union1d(free, prob.free_all[np.isin(prob.free_all, (3, 15))])
     trial = refit(best, free, curved)

@@ -51,20 +51,34 @@ def drive_gain(modal: pd.DataFrame) -> tuple[complex, complex, float] | None:
     slope; the median of the real and imaginary parts of A_c and A'. Without sweep fits, the dwells'
     (`jointcal.measure.dwell.dwell_mode`'s A of each level, in modal_properties.csv's ``dwell_constant_re``
     and ``_im``): their median, unsloped, at the median of the dwell rows' f_res_hz. None without either.
+
+    A force at the driving point (a ``level_lbf`` table) drives the mode through 1/m, real and flat: the
+    median of |A|, no slope. A phase the read-out found there (`jointcal.measure.sweepfit`: a response
+    channel that lags the force channel) is the channels', not the drive's: the model is driven without it,
+    so the validation and the discrepancy stage see it (its ``channel_delay``).
     """
     need = ("modal_constant_re", "modal_constant_im", "modal_slope_re", "modal_slope_im", "f_res_hz")
     if not all(c in modal.columns for c in need):
-        return dwell_gain(modal)
+        return _real_if_force(modal, dwell_gain(modal))
     ok = modal[list(need)].apply(pd.to_numeric, errors="coerce").dropna()
     if ok.empty:
-        return dwell_gain(modal)
+        return _real_if_force(modal, dwell_gain(modal))
     w = 2 * np.pi * ok["f_res_hz"].to_numpy()
     wc = float(np.median(w))
     a = ok["modal_constant_re"].to_numpy() + 1j * ok["modal_constant_im"].to_numpy()
     da = ok["modal_slope_re"].to_numpy() + 1j * ok["modal_slope_im"].to_numpy()
+    if level_column(modal.columns) == LEVEL["force"]:
+        return complex(np.median(np.abs(a))), 0j, wc
     ac = a + da * (wc - w)
     med = lambda z: complex(np.median(z.real), np.median(z.imag))  # noqa: E731
     return med(ac), med(da), wc
+
+
+def _real_if_force(modal: pd.DataFrame, gain: tuple[complex, complex, float] | None):
+    """A force's modal constant as `drive_gain` takes it: |A|, no slope (other drives: as given)."""
+    if gain is None or level_column(modal.columns) != LEVEL["force"]:
+        return gain
+    return complex(abs(gain[0])), 0j, gain[2]
 
 
 def dwell_gain(modal: pd.DataFrame) -> tuple[complex, complex, float] | None:
