@@ -32,8 +32,9 @@ The slope is refit only where the fast model is within the repeat scatter of its
 (`refits_slope`: the floor E at most `rule.FLOOR_HIGH`); above it, the fast model that would judge the
 slope is further from its record than the slope moves it (the real UNESP beam: floor 30).
 
-A force at the driving point is 1/m by physics (real, no slope, `jointcal.measure.sweepfit`):
-its drive is left as the read-out gives it.
+A force at the driving point is 1/m by physics (real, no slope): its drive is |A| as the read-out gives it
+(`validate.drive.drive_gain`); a phase the read-out's A took (`jointcal.measure.sweepfit`: a response channel
+lagging the force) is the channels', left in the data for the library's channel_delay to find.
 """
 from __future__ import annotations
 

@@ -14,7 +14,7 @@ Omega shared between a viscous part and a hysteretic part phi (a joint's frictio
 loss per cycle does not grow with frequency; phi matters where the data lie off Omega,
 e.g. a force-driven rig's response peaks at the shaker-loaded resonance), and A(w) the
 modal constant at the drive frequency w: 1/m for a force at the driving point (real, no
-slope), complex and linear in w for an amplifier voltage, A = A_0 + A_1 (w / W_0 - 1)
+slope; a phase only where a response channel lags the force and the phase earns its place), complex and linear in w for an amplifier voltage, A = A_0 + A_1 (w / W_0 - 1)
 (the shaker's electrical phase and the residual modes).
 
 Written in a frame rotating at the fixed frequency W_0 (the start value), x_a = Z e^{i W_0 t},
