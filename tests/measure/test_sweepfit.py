@@ -84,6 +84,20 @@ def test_a_response_channel_lagging_the_force_is_read_as_a_phase_of_a_not_as_dam
         assert fit.modal_constant.imag == 0.0
 
 
+def test_a_response_channel_leading_the_force_is_not_read_as_a_delay():
+    """The same chirp with the response channel ADVANCED by the same 14 deg: no channel's delay leads, so A's phase
+    is not freed for it (`sweepfit._lags`) and A stays real, as a force's 1/m is; the lead is left in the
+    misfit (here larger than with the lag read as A's phase), for the discrepancy stage's library to explain."""
+    p = IwanParams(313.0, 1.02e6, -0.65, 0.004)
+    model = MinistackModel(m=2.65 / G, k=6.12e5, zeta_v=0.0015, iwan=p)
+    fs, tau = 25600.0, -np.radians(14.0) / (2 * np.pi * 2250.0)
+    F, acc = _force_chirp(model, 1700.0, 2700.0, 20 * (2250.0 * 0.015) ** 2, fs, 4.0)
+    fit = fit_swept_mode(F, fractional_delay(acc, tau, fs), fs, 2250.0, 0.015, modal_phase=0.0)
+    lagged = fit_swept_mode(F, fractional_delay(acc, -tau, fs), fs, 2250.0, 0.015, modal_phase=0.0)
+    assert fit.modal_constant.imag == 0.0 and lagged.modal_constant.imag < 0.0
+    assert fit.residual > 2 * lagged.residual
+
+
 def test_a_record_without_drive_is_refused():
     with pytest.raises(ValueError, match="drive"):
         fit_swept_mode(np.zeros(1000), np.ones(1000), 1024.0, 100.0, 0.01)

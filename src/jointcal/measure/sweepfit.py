@@ -72,7 +72,8 @@ the jointed beam (tau 4e-4 s, 14 deg at 98.5 Hz) the fit took the hysteretic sha
 high and |A| 33% above 1/m (misfit 0.051, under `modal.sweep_misfit`: read silently). So with a fixed phase
 the fit is also run with A's quadrature part free (one parameter, `_sweep_problem.PHASE`), and that fit is
 kept where it earns its place as the residual terms must (`_sweep_problem.earns`: the information criterion
-and the misfit's sum of squares cut by `earn`): on that run the damping 0.0121 (harmonic balance 0.0120),
+and the misfit's sum of squares cut by `earn`) and is a lag, as a delay's is (`_lags`; a lead is a neighbouring
+mode's line or the model's own misfit, left as before): on that run the damping 0.0121 (harmonic balance 0.0120),
 |A| 385.1 (1/m 386.1), A's phase -13.8 deg (-W_0 tau -14.2), misfit 0.006. A's phase is then the channels',
 not the force's: `jointcal.validate.drive.drive_gain` drives the model with |A| alone.
 
@@ -157,6 +158,16 @@ class SweepFit:
         if self.coil is not None:  # the pole of the mode with its coil
             return coil_pole(om**2, dr * np.exp(b1 * L + b2 * L**2), *self.coil)
         return om / (2 * np.pi), dr * np.exp(b1 * L + b2 * L**2) / (2 * om)  # at w = Omega
+
+
+def _lags(sol, free: NDArray) -> bool:
+    """Whether a fit with A's quadrature part free (`_sweep_problem.PHASE`) puts the response behind the force: A's
+    phase at the mode below 0. A channel's delay only lags (-W_0 tau, tau > 0); a lead is not a delay (on the jointed
+    beam with a neighbouring mode above, the fit took a lead of 1.1-1.6 deg growing with the level and |A| 3-5% above
+    1/m: the neighbour's line, which the force held real leaves to the discrepancy stage's library)."""
+    p = np.zeros(max(int(np.max(free)) + 1, PHASE + 1))
+    p[free] = sol.x
+    return bool(np.angle(p[6] + 1j * p[PHASE]) < 0.0)
 
 
 def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: float, *,
@@ -250,7 +261,7 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
         if prob.fixed:  # the channels' phase at the mode, where it earns its place (module notes)
             lagged = np.union1d(free, [PHASE])
             trial = fit_from_starts(prob, lagged, f0, zeta0)
-            if earns(prob, trial, best, 1, earn):
+            if _lags(trial, lagged) and earns(prob, trial, best, 1, earn):
                 best, free = trial, lagged
         return (prob, *earned_terms(prob, best, free, frequency_curvature, earn))
 
