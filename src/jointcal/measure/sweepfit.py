@@ -261,8 +261,10 @@ def fit_swept_mode(ref: NDArray, resp_g: NDArray, fs: float, f0: float, zeta0: f
         if prob.fixed:  # the channels' phase at the mode, where it earns its place (module notes)
             lagged = np.union1d(free, [PHASE])
             trial = fit_from_starts(prob, lagged, f0, zeta0)
-            if _lags(trial, lagged) and earns(prob, trial, best, 1, earn):
-                best, free = trial, lagged
+            if earns(prob, trial, best, 1, earn):
+                out = earned_terms(prob, trial, lagged, frequency_curvature, earn)
+                if _lags(*out):  # judged with the residual terms it keeps (they can turn a small lag into a lead)
+                    return (prob, *out)
         return (prob, *earned_terms(prob, best, free, frequency_curvature, earn))
 
     if coil is not None and not (coil == "fit" or len(coil) == 2 and coil[0] > 0 and coil[1] >= 0):
