@@ -283,6 +283,15 @@ phase of their own, +0.50 and -0.01 deg (seed 1: the sum of squares cut 2.6x on 
 single-mode averaged model's misfit at the top level, not a channel's lag; |A| 386.7 either way, E before 10.53 ->
 10.50. A campaign-level test (a delay's phase the same -w tau in every run, a model's misfit growing with the level)
 would tell them apart; not done. Voltage paths not touched (a voltage's A is complex and sloped as before).
+
+After the merge, a regression and its fix (2026-11-26, main ea535fb). With a neighbouring mode above the mode, the
+freed phase took leads of +1.1 to +1.6 deg growing with the level, |A| 397-404 (1/m 386): neighbour_mode force seed 1
+fell to medium (E 111.20 -> 2.77, held-out 2.64). A channel's delay only lags, so A's phase is kept only where it is
+a lag, judged on the read-out with the residual terms it keeps (`measure.sweepfit._lags`; one run's trial lag of
+-0.8 deg became a +1.4 deg lead with them). End to end on ea535fb (load 4-5, the suite beside it):
+
+    neighbour_mode                       force    seed 1: neighbour_mode                       high   E 110.88 ->  1.71 ( -98%) floor 0.17 stage 132 s
+    channel_delay                        force    seed 2: channel_delay                        high   E  33.20 ->  0.66 ( -98%) floor 0.25 stage 126 s
 """
 import argparse
 import json
