@@ -24,6 +24,16 @@ def test_a_force_drives_through_the_magnitude_of_its_modal_constant_the_lag_is_t
     assert wc == pytest.approx(2 * np.pi * 98.7)
 
 
+def test_a_force_read_away_from_the_driving_point_keeps_its_residues_sign():
+    """A response sensor away from the driving point reads the mode's real residue phi_s phi_d / m, which can be
+    negative; a lagging channel turns it by -w tau. The model is driven through the residue with its sign, real and
+    flat (its magnitude alone would turn the drive by 180 deg)."""
+    r, tau = -0.4 / 0.00259, 4e-4
+    f = np.array([99.4, 98.7, 97.6])
+    ac, da, _ = drive_gain(_table("level_lbf", r * np.exp(-2j * np.pi * f * tau), np.zeros(3, complex), f))
+    assert ac == pytest.approx(r, rel=1e-12) and ac.imag == 0.0 and da == 0j
+
+
 def test_a_voltage_keeps_its_complex_constant_and_slope():
     """A voltage's A(w) is the coil's and the amplifier's, complex and sloped: moved to the median resonance
     along each run's slope, the medians of its parts."""

@@ -52,8 +52,8 @@ def drive_gain(modal: pd.DataFrame) -> tuple[complex, complex, float] | None:
     (`jointcal.measure.dwell.dwell_mode`'s A of each level, in modal_properties.csv's ``dwell_constant_re``
     and ``_im``): their median, unsloped, at the median of the dwell rows' f_res_hz. None without either.
 
-    A force at the driving point (a ``level_lbf`` table) drives the mode through 1/m, real and flat: the
-    median of |A|, no slope. A phase the read-out found there (`jointcal.measure.sweepfit`: a response
+    A force (a ``level_lbf`` table) drives the mode through a real, flat constant (1/m at the driving point):
+    the median of |A| with the sign of A's real part (`_signed_abs`), no slope. A phase the read-out found there (`jointcal.measure.sweepfit`: a response
     channel that lags the force channel) is the channels', not the drive's: the model is driven without it,
     so the validation and the discrepancy stage see it (its ``channel_delay``).
     """
@@ -68,7 +68,7 @@ def drive_gain(modal: pd.DataFrame) -> tuple[complex, complex, float] | None:
     a = ok["modal_constant_re"].to_numpy() + 1j * ok["modal_constant_im"].to_numpy()
     da = ok["modal_slope_re"].to_numpy() + 1j * ok["modal_slope_im"].to_numpy()
     if level_column(modal.columns) == LEVEL["force"]:
-        return complex(np.median(np.abs(a))), 0j, wc
+        return complex(np.median(_signed_abs(a))), 0j, wc
     ac = a + da * (wc - w)
     med = lambda z: complex(np.median(z.real), np.median(z.imag))  # noqa: E731
     return med(ac), med(da), wc
@@ -78,7 +78,14 @@ def _real_if_force(modal: pd.DataFrame, gain: tuple[complex, complex, float] | N
     """A force's modal constant as `drive_gain` takes it: |A|, no slope (other drives: as given)."""
     if gain is None or level_column(modal.columns) != LEVEL["force"]:
         return gain
-    return complex(abs(gain[0])), 0j, gain[2]
+    return complex(_signed_abs(np.array([gain[0]]))[0]), 0j, gain[2]
+
+
+def _signed_abs(a: NDArray[np.complex128]) -> NDArray[np.float64]:
+    """|A| with the sign of A's real part: a force's modal constant without the channels' phase (a response
+    sensor away from the driving point can read a negative real residue; a channel's lag turns A by well
+    under 90 deg)."""
+    return np.abs(a) * np.where(a.real < 0, -1.0, 1.0)
 
 
 def dwell_gain(modal: pd.DataFrame) -> tuple[complex, complex, float] | None:
