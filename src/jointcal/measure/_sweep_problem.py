@@ -291,15 +291,12 @@ def earned_terms(prob: Problem, best, free: NDArray, frequency_curvature: str, e
         p_now[old] = sol.x
         return prob.solve(p_now[new], new, 60)
 
-    def better(sol_more, sol_less, k, factor):
-        return earns(prob, sol_more, sol_less, k, factor)
-
     curved = np.union1d(free, prob.free_all[np.isin(prob.free_all, (3, 15))])
     trial = refit(best, free, curved)
-    if frequency_curvature == "always" or frequency_curvature == "bic" and better(trial, best, 2, 1.0):
+    if frequency_curvature == "always" or frequency_curvature == "bic" and earns(prob, trial, best, 2, 1.0):
         best, free = trial, curved
     no_b = free[~np.isin(free, (11, 12, 13, 14, 16, 17))]
     trial = refit(best, free, no_b)
-    if better(best, trial, free.size - no_b.size, earn):
+    if earns(prob, best, trial, free.size - no_b.size, earn):
         return best, free
     return trial, no_b

@@ -75,7 +75,8 @@ kept where it earns its place as the residual terms must (`_sweep_problem.earns`
 and the misfit's sum of squares cut by `earn`) and is a lag, as a delay's is (`_lags`; a lead is a neighbouring
 mode's line or the model's own misfit, left as before): on that run the damping 0.0121 (harmonic balance 0.0120),
 |A| 385.1 (1/m 386.1), A's phase -13.8 deg (-W_0 tau -14.2), misfit 0.006. A's phase is then the channels',
-not the force's: `jointcal.validate.drive.drive_gain` drives the model with |A| alone.
+not the force's: `jointcal.validate.drive.drive_gain` drives the model with |A| alone (the sign of A's
+real part kept).
 
 An amplifier voltage drives the mode through the shaker's coil, whose corner R / L can sit near the
 mode (0.74 of it on the Ministack rig): its back-EMF damping then falls across the resonance, which
