@@ -102,10 +102,12 @@ def _voltage_campaign():
     return rows, modal, best
 
 
-def _stand_ins(monkeypatch, floor: float, scores: dict[str, float]) -> dict:
+def _stand_ins(monkeypatch, floor: float, scores: dict[str, float], own: dict[str, float] | None = None) -> dict:
     """Recording stand-ins in the stage for everything but its drive logic and `rule.decide`: the floor E `floor`,
-    the library scored at `scores` (name -> held-out score, whatever the drive), the n-th slope refit handing out
-    its own drive (READ_OUT_GAIN's slope + n x 0.01i); returns what they saw."""
+    the library scored at `scores` (name -> held-out score and E on all runs, whatever the drive; `own`: a single's
+    score on the drive refit with it, where it differs), the n-th slope refit handing out its own drive
+    (READ_OUT_GAIN's slope + n x 0.01i); returns what they saw."""
+    own = own or {}
     from types import SimpleNamespace
 
     from jointcal.discrepancy import stage
@@ -126,13 +128,17 @@ def _stand_ins(monkeypatch, floor: float, scores: dict[str, float]) -> dict:
                 "baseline_E_refined": 1.0}
         return new, build(new), info
 
+    def scored_as(name, theta0, *, space, m, scales, score):
+        c = candidate(name, space, m, scales)
+        th = c.grown.vector(dict(zip(PARAMS, theta0[:len(PARAMS)])), default={p.name: p.start for p in c.effect_params})
+        return Scored(name, Fit(name, th, score, 1e-4 * np.eye(c.grown.ndim), 1), score)
+
     def score_singles(assembly, space, m, theta0, settings, clock, say, scales, runs, prev=None):
-        out = []
-        for name, score in scores.items():
-            c = candidate(name, space, m, scales)
-            th = c.grown.vector(dict(zip(PARAMS, theta0)), default={p.name: p.start for p in c.effect_params})
-            out.append(Scored(name, Fit(name, th, score, 1e-4 * np.eye(c.grown.ndim), 1), score))
-        return out
+        return [scored_as(name, theta0, space=space, m=m, scales=scales, score=score) for name, score in scores.items()]
+
+    def score_on_own_drive(cands, runs, theta0, **kw):  # `_lead_on_its_drive`'s scoring: the same scores
+        return [scored_as(c.name, theta0, space=c.space, m=c.m, scales=None, score=own.get(c.name, scores[c.name]))
+                for c in cands]
 
     def recalibrated(assembly, final, space, m, runs, *args):
         seen["recalibrated_runs"] = runs
@@ -145,6 +151,7 @@ def _stand_ins(monkeypatch, floor: float, scores: dict[str, float]) -> dict:
     fp = {"h2_ratio": 0.0, "h3_ratio": 0.0}
     ver = {n: {"for": [], "against": []} for n in scores}
     for name, fn in {"_usable_runs": usable_runs, "refine_slope": refine_slope, "_score_singles": score_singles,
+                     "score_candidates": score_on_own_drive,
                      "_add_pairs": lambda *a, **k: (a[9], []),
                      "_recalibrated": recalibrated, "validate_runs": validate_runs,
                      "fast_floor": lambda *a: {"E": floor, "per_level": {}},
@@ -265,3 +272,38 @@ def test_a_pairs_fingerprints_name_what_both_effects_share_once():
     even = [w for w in pair if w.startswith("even harmonics dominate")]
     assert len(even) == 1 and any(w.startswith("even harmonics") for w in one)
     assert len(pair) == len(set(pair)) == len(set(ver["neighbour_mode"]["against"] + ver["channel_delay"]["against"]))
+
+
+def test_a_voltage_drives_lead_is_the_single_that_scores_best_on_the_drive_refit_with_it(monkeypatch):
+    """Every single effect that fits the runs better than the baseline (E on all runs) has the drive's slope refit
+    with it and is scored again on that drive; the lead is the best there. The stand-ins replay the voltage campaign
+    hiding a channel delay: on the baseline's drive the neighbouring mode scores best (1.8) and the delay no better
+    than the baseline (2.4 against 2.3), though it fits better (E 1.85 against 2.07); each on its own drive the delay
+    scores 1.2 and the neighbour 1.4. A single that fits no better (cubic, E 2.10) is not refit."""
+    from types import SimpleNamespace
+
+    from jointcal.discrepancy import stage
+    from jointcal.discrepancy.fit import Fit, candidate
+    from jointcal.discrepancy.select import Scored
+    from tests._support.beam_runs import BEAM, BEAM_JOINT, beam_space
+
+    first = {"baseline": (2.3, 2.07), "neighbour_mode": (1.8, 1.49), "channel_delay": (2.4, 1.85),
+             "cubic_stiffening": (2.5, 2.10)}
+    seen = _stand_ins(monkeypatch, 0.5, {n: sc for n, (sc, _) in first.items()},
+                      own={"channel_delay": 1.2, "neighbour_mode": 1.4})
+    space = beam_space()
+    scored = []
+    for name, (score, E) in first.items():
+        c = candidate(name, space, BEAM.m)
+        th = c.grown.vector(dict(zip(PARAMS, BEAM_JOINT)), default={p.name: p.start for p in c.effect_params})
+        scored.append(Scored(name, Fit(name, th, E, 1e-4 * np.eye(c.grown.ndim), 1), score))
+    said = []
+    lead, gain, runs, info = stage._lead_on_its_drive(
+        "beam", space, BEAM.m, BEAM_JOINT, DiscrepancySettings(), stage._Clock(), said.append, None, scored,
+        READ_OUT_GAIN, lambda g: [SimpleNamespace(gain=g)])
+    assert [name for name, *_ in seen["refits"]] == ["neighbour_mode", "channel_delay"]  # by first-pass score
+    assert all(g == READ_OUT_GAIN for _, g, _ in seen["refits"])  # each from the baseline's drive
+    assert lead.name == "channel_delay" and lead.score == 1.2
+    assert gain == seen["refits"][1][2] and runs[0].gain == gain
+    assert complex(*info["relative_slope_refined"]) == pytest.approx(gain[1] * gain[2] / gain[0])
+    assert len(said) == 2 and "2.40 -> 1.20" in said[1]

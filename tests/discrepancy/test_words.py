@@ -52,7 +52,7 @@ def test_the_words_never_contradict_the_verdict():
 
 def test_the_words_say_when_and_why_a_voltage_drives_slope_is_not_taken():
     """The floor's sentence says the slope is not refit exactly where the stage did not refit it (a voltage drive, no
-    refit, floor above the repeat scatter E 1), and says a rejected slope is past any coil's (|A' w_c / A_c| 1)."""
+    refit, floor above the repeat scatter E 1); a refit coil is stated with its x and its corner R / L (w_c / x)."""
     def words(unit, floor, drive=None):
         d = _diagnosis("none", 0.37, 0.2, 1.1, floor, [("sensor_gain", 1.1)])
         return diagnosis_markdown({**d, "level_unit": unit, "voltage_drive": drive})
@@ -61,6 +61,9 @@ def test_the_words_say_when_and_why_a_voltage_drives_slope_is_not_taken():
     assert not_refit in words("V", 2.0) and "read-out's drive is kept" in words("V", 2.0)
     assert not_refit not in words("V", 0.5)  # below the scatter the stage refits it
     assert not_refit not in words("lbf", 2.0)  # a force's drive is never refit: nothing to say
-    rejected = {"slope_read_out": [0.0, 0.0], "slope_refined": [0.0, 0.0], "slope_rejected": [-6.6, 1.3]}
-    said = words("V", 0.5, rejected)
-    assert "-6.600+1.300i" in said and "past any coil's (magnitude 1)" in said and not_refit not in said
+    coil = {"slope_read_out": [0.0, 0.0], "slope_refined": [-1e-3, -2e-3], "relative_slope_read_out": [0.0, 0.0],
+            "relative_slope_refined": [-0.0099, -0.0995], "coil_x": 0.1, "baseline_E_read_out": 5.9,
+            "baseline_E_refined": 2.1}
+    said = words("V", 0.5, coil)
+    assert "x = w_c L / R = 0.100" in said and "R / L at 10 w_c" in said and "-0.010-0.100i" in said
+    assert "5.90 -> 2.10" in said and not_refit not in said

@@ -35,6 +35,7 @@ from scipy.optimize import least_squares
 from ..calibrate.space import PARAMS, ParamSpace
 from ..models import MinistackModel, swept_transmissibility
 from ..models.swept import quasi_steady_runs
+from ..validate.drive import delay_reference
 from .data import RunEnvelope, run_zeta
 from ..effects import EFFECTS, apply_effect, effects_of
 
@@ -138,7 +139,8 @@ def observed(model: MinistackModel, T: NDArray, run: RunEnvelope) -> NDArray[np.
         return T
     gain = np.asarray(model.sensor_gain, dtype=float)
     tau = np.asarray(model.sensor_delay_s, dtype=float)
-    return run.equivalent_base * (T - gain * np.exp(-2j * np.pi * run.f_hz * tau))
+    turn = np.exp(1j * delay_reference(run.row) * tau)  # a voltage's A_c holds the delay at w_c
+    return run.equivalent_base * turn * (T - gain * np.exp(-2j * np.pi * run.f_hz * tau))
 
 
 def transient_factor(c: Candidate, theta: NDArray, run: RunEnvelope) -> NDArray[np.complex128] | None:

@@ -20,7 +20,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from ..effects import EFFECTS
-from .drive import MAX_RELATIVE_SLOPE, refits_slope
+from .drive import refits_slope
 from .rule import FLOOR_HIGH, HIGH_SCORE, NONE_E
 
 __all__ = ["diagnosis_markdown"]
@@ -51,19 +51,16 @@ def _drive(d: Mapping) -> str:
     if v is None and d.get("level_unit") == "V" and not refits_slope("V", fl):
         return (" The voltage drive's slope is not refit: the fast model that would judge it is off its own time "
                 "simulation by more than the repeat scatter; the read-out's drive is kept.")
-    if v and "slope_rejected" in v:
-        r = complex(*v["slope_rejected"])
-        return (f" The voltage drive's slope refit with the baseline, A' w_c / A_c = {r.real:.3f}{r.imag:+.3f}i, is "
-                f"past any coil's (magnitude {MAX_RELATIVE_SLOPE:g}): the baseline bent the drive to what it misses, "
-                "so the read-out's drive is kept.")
     if not v or v["slope_refined"] == v["slope_read_out"]:
         return ""
     a, b = complex(*v["relative_slope_read_out"]), complex(*v["relative_slope_refined"])
-    return (f" The voltage drive's modal constant changes across the band by A' w_c / A_c = {b.real:.3f}{b.imag:+.3f}i "
-            f"per unit w / w_c, not the read-out's {a.real:.3f}{a.imag:+.3f}i (the coil's phase, which the "
-            "read-out's narrow window leaves out): refit with the baseline (its E "
-            f"{v['baseline_E_read_out']:.2f} -> {v['baseline_E_refined']:.2f}), every candidate and the E after "
-            "take it.")
+    corner = f"a corner R / L at {1 / v['coil_x']:.2g} w_c" if v.get("coil_x") else "no inductance"
+    return (f" The voltage drive's modal constant changes across the band as a coil's (x = w_c L / R = "
+            f"{v.get('coil_x', 0.0):.3f}, {corner}): A' w_c / A_c = {b.real:.3f}{b.imag:+.3f}i per unit w / w_c, "
+            f"not the read-out's {a.real:.3f}{a.imag:+.3f}i (the read-out's narrow window leaves the coil's phase "
+            f"out): refit with the baseline (its E {v['baseline_E_read_out']:.2f} -> {v['baseline_E_refined']:.2f}), "
+            "every candidate and the E after take it. A coil ties its phase slope to its magnitude tilt; a phase "
+            "that turns faster is left to the channels (channel_delay).")
 
 
 def _named(d: Mapping, E0: float, E1: float) -> list[str]:

@@ -20,7 +20,7 @@ from ..models import MinistackModel, fractional_delay, simulate
 from ..units import G
 
 __all__ = ["reference_column", "clean_base", "drive_gain", "gain_at", "equivalent_base", "model_input",
-           "dwell_gain", "response_to", "simulate_record"]
+           "dwell_gain", "delay_reference", "response_to", "simulate_record"]
 
 
 def reference_column(record: pd.DataFrame) -> str:
@@ -107,6 +107,19 @@ def gain_at(gain: tuple[complex, complex, float], f_hz: NDArray) -> NDArray[np.c
     return ac + da * np.clip(w - wc, -0.45 * wc, 0.45 * wc)
 
 
+def delay_reference(row: Mapping) -> float:
+    """The frequency (rad/s) from which a model's channel delay tau is counted for the run's drive: the drive
+    is turned by +w tau there.
+
+    A voltage's modal constant A_c is read from the response channel at w_c (the median resonance), so it
+    holds the channel's phase there, -w_c tau with the coil's: a model that delays its channel by tau adds
+    only -(w - w_c) tau to it. A force drives through its real |A| (`drive_gain`: the channels' phase is left
+    in the data) and a base through itself: 0, the whole -w tau.
+    """
+    gain = row.get("drive_gain")
+    return float(gain[2]) if gain is not None and level_column(row) == LEVEL["voltage"] else 0.0
+
+
 def equivalent_base(row: Mapping, f_hz: NDArray) -> NDArray[np.complex128] | None:
     """The equivalent base acceleration per unit reference at frequencies f, -A(w) / G (g per lbf or per V),
     for a force or voltage run with its ``drive_gain``; None for a base drive (the reference is the base).
@@ -158,6 +171,10 @@ def simulate_record(model: MinistackModel, record: pd.DataFrame, row: Mapping) -
     Samples where the measured reference is not finite are NaN in the simulated response too,
     so the same frames are left out of both envelopes.
     """
+    turn = delay_reference(row) * float(model.sensor_delay_s)
+    if turn:  # the drive's A_c holds the channel's delay at w_c (`delay_reference`)
+        ac, da, wc = row["drive_gain"]
+        row = {**row, "drive_gain": (ac * np.exp(1j * turn), da * np.exp(1j * turn), wc)}
     a_b, col = model_input(record, row)
     y = response_to(model, a_b, float(row["sample_rate_hz"]), relative=col != REFERENCE["base"])
     y[~np.isfinite(record[col].to_numpy(dtype=float))] = np.nan
