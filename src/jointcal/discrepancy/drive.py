@@ -137,6 +137,8 @@ def refine_slope(c0: Candidate, theta0: NDArray, gain: Gain, build: Callable[[Ga
     runs = list(build((ac, da, wc)))
     for n in range(rounds):
         x_new = float(np.clip(x + _coil_step(Objective(c0, runs).at(theta), theta, (ac, da, wc), x), 0.0, X_MAX))
+        if abs(x_new - x) < 0.02 * max(x, 0.01):  # the model leaves the coil where it is: nothing to refit
+            break
         trial = list(build((ac, ac * coil_slope(x_new) / wc, wc)))
         again = Objective(c0, trial).fit(theta, starts=1, max_nfev=max_nfev, refresh=1)
         if n and again.E >= fit.E:  # no better than the last x (the first is judged against the read-out's drive)

@@ -323,8 +323,9 @@ def _lead_on_its_drive(assembly, space, m, theta0, settings, clock, say, scales,
     for s in sorted((s for s in scored if s.name != "baseline" and s.fit.E < base.fit.E), key=lambda s: s.score):
         c = candidate(s.name, space, m, scales)
         g, runs, info = refine_slope(c, s.fit.theta, gain, build, max_nfev=settings.max_nfev)
-        own = score_candidates([c], runs, theta0, baseline=base, max_nfev=settings.max_nfev,
-                               starts={s.name: [theta0, s.fit.theta]})[0]
+        # a drive the effect leaves where it was: its score stands
+        own = s if g == gain else score_candidates([c], runs, theta0, baseline=base, max_nfev=settings.max_nfev,
+                                                   starts={s.name: [theta0, s.fit.theta]})[0]
         say(f"{assembly}: {s.name} on the drive refit with it ({complex(*info['relative_slope_refined']):.3f}): "
             f"held-out score {s.score:.2f} -> {own.score:.2f}")
         if best is None or own.score < best[0].score:
