@@ -39,7 +39,8 @@ def pytest_configure(config: pytest.Config) -> None:
     With xdist the compilation runs in a thread while the workers start and collect (each takes about 6 s of its
     own: imports and collection), and each worker waits for it before its first test (`pytest_runtestloop`), so the
     compilation no longer precedes the workers' start: on a fresh clone it took 15-30 s of wall time with the other
-    core idle. Without workers it runs here, before the tests, as before."""
+    core idle. Without workers it runs here, before the tests, as before. With workers the measure package's kernels
+    are compiled beside it, in a process of their own (`_compile_measure_kernels_aside`)."""
     if hasattr(config, "workerinput"):  # an xdist worker: the controller compiles them
         return
     from jointcal.models.kernels import compile_kernels
@@ -49,14 +50,39 @@ def pytest_configure(config: pytest.Config) -> None:
         return
     done = Path(tempfile.mkdtemp(prefix="jointcal-kernels-")) / "compiled"
     os.environ[KERNELS_DONE] = str(done)  # the workers, started after this hook, inherit the environment
+    measure = _compile_measure_kernels_aside(config)
 
     def compile_then_say_so() -> None:
         try:
             compile_kernels()
         finally:  # a failure too: the workers then compile what they call, as without this
+            if measure is not None:
+                measure.wait()
             done.write_text("compiled\n")
 
     threading.Thread(target=compile_then_say_so, name="compile_kernels", daemon=True).start()
+
+
+def _compile_measure_kernels_aside(config: pytest.Config):
+    """The measure package's kernels (`tests._support.kernels.compile_measure_kernels`) compiled in a process of
+    their own, beside the controller's compilation of the models' (`pytest_configure`), on the core that compilation
+    leaves idle while the workers start; the workers wait for both. Without it each of them was compiled by the
+    first worker or Snakemake job that called it, in the middle of a test (test_coil's first read 25.6 s cold, 4.4 s
+    warm), and again by any other that called it before the cache was written. Returns the process (None if it
+    could not start: the kernels are then compiled where they are called, as before)."""
+    import subprocess
+    import sys
+
+    import jointcal
+
+    path = [str(Path(jointcal.__file__).resolve().parents[1]), str(config.rootpath)]  # the jointcal the workers import
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(path + [os.environ.get("PYTHONPATH", "")])}
+    try:
+        return subprocess.Popen([sys.executable, "-c", "from tests._support.kernels import compile_measure_kernels; "
+                                 "compile_measure_kernels()"], cwd=config.rootpath, env=env,
+                                stdout=subprocess.DEVNULL)
+    except OSError:
+        return None
 
 
 KERNELS_DONE = "JOINTCAL_TESTS_KERNELS_COMPILED"  # the file the controller writes once the kernels are in the cache

@@ -16,7 +16,6 @@ from typing import IO, Any
 
 import numpy as np
 import pandas as pd
-import scipy.io
 from numpy.typing import ArrayLike
 
 from jointcal.io.contract import REFERENCE, RESPONSE, TIME, Excitation
@@ -178,6 +177,8 @@ def write_run(path: str | os.PathLike[str], time_s: ArrayLike, base_or_force: Ar
                          f"got shapes {[v.shape for v in cols.values()]}")
     name = Path(path).name.lower()
     if name.endswith(".mat"):
+        import scipy.io  # here: the workflow imports jointcal.io to name its jobs, every Snakemake run and stage
+
         buf = io.BytesIO()
         scipy.io.savemat(buf, cols, do_compression=True, oned_as="column")
         data = buf.getvalue()

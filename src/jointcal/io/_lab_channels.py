@@ -15,7 +15,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import scipy.io
 from numpy.typing import NDArray
 
 from jointcal.io.contract import fail
@@ -160,6 +159,8 @@ def _tdms(path: Path) -> list[Channel]:
 
 def _testlab(path: Path) -> list[Channel]:
     """The signals of a Simcenter Test.Lab MATLAB export (scipy.io), in the unit its quantity defines."""
+    import scipy.io  # here: the workflow imports jointcal.io to name its jobs, every Snakemake run and stage
+
     try:
         mat = scipy.io.loadmat(path, simplify_cells=True)
     except (OSError, ValueError) as exc:  # a file cut short: 'could not read bytes'

@@ -11,7 +11,6 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
-import scipy.io
 from numpy.typing import NDArray
 
 from jointcal.io._checks import validate_run
@@ -173,6 +172,8 @@ def _in_g(cols: dict[str, NDArray[np.float64]], fmt: str) -> tuple[dict[str, NDA
 
 def _read_mat(path: Path, kind: Excitation | None, channels: dict[str, str | None],
               row: Mapping[str, Any] | None, lab: dict) -> tuple[dict[str, NDArray[np.float64]], dict[str, Any]]:
+    import scipy.io  # here: the workflow imports jointcal.io to name its jobs, every Snakemake run and stage
+
     try:
         mat = scipy.io.loadmat(path)
     except NotImplementedError:

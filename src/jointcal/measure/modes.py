@@ -31,7 +31,6 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
-from scipy import signal
 
 from ..io.contract import UNUSABLE
 
@@ -64,6 +63,8 @@ def modal_peaks(f: NDArray, X: NDArray, coherence: NDArray, band: tuple[float, f
     ndarray
         Peak frequencies (Hz) of the lines that pass the module's tests, the highest peak of |X| first.
     """
+    from scipy import signal  # here, not at the top: the workflow imports this module to name its jobs (`units`)
+
     f, X, coherence = (np.asarray(v) for v in (f, X, coherence))
     lo, hi = sorted(band)
     a = np.abs(X)

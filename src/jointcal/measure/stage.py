@@ -20,11 +20,7 @@ import pandas as pd
 
 from .._campaign_index import unit_table
 from ..io import listed_record, read_run, write_csv_atomic
-from .campaign import campaign_modal
-from .flags import run_flags
-from .frf import frf_table
 from .scatter import scatter
-from .testkinds.read import backbone_table
 
 __all__ = ["run_modal", "run_modal_unit"]
 
@@ -62,6 +58,13 @@ def run_modal(runs_csv: _Path, envelope_files: Sequence[_Path], record_files: Se
     pandas.DataFrame
         ``modal_properties.csv``'s table.
     """
+    # here, not at the top: `run_modal_unit` (a job per unit, splitting tables) needs none of them, and they import
+    # scipy.signal and numba (about 2 s of CPU at a job's start)
+    from .campaign import campaign_modal
+    from .flags import run_flags
+    from .frf import frf_table
+    from .testkinds.read import backbone_table
+
     runs = pd.read_csv(runs_csv, dtype={"flags": str})
     env_dir = Path(envelope_files[0]).parent
     records = [str(r) for r in record_files]

@@ -28,7 +28,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-import emcee
 import numpy as np
 import scipy.fft
 from numpy.typing import NDArray
@@ -183,6 +182,8 @@ def run_chain(log_prob: Callable[[NDArray[np.float64]], NDArray[np.float64]], x0
     -------
     ChainResult
     """
+    import emcee  # here: it imports scipy.stats (~1 s), which the figure, report and design jobs never need
+
     if resume is not None and len(resume["chain"]):
         chain, lp = np.asarray(resume["chain"]), np.asarray(resume["log_prob"])
         hist = [np.asarray(h) for h in resume["tau_history"]]

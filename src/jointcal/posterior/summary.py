@@ -11,7 +11,6 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-import emcee
 import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
@@ -63,6 +62,8 @@ def summarize(chain_x: NDArray[np.float64], lower: NDArray[np.float64], upper: N
         width_ratio (posterior 90% width / prior width in x), constrained (empty
         for the derived rows). Extra rows: K0 = k + KT (lbf/in) and phi_max (in, eq. 3.7).
     """
+    import emcee  # here: it imports scipy.stats (~1 s), which the figure, report and design jobs never need
+
     kept = chain_x[burn:]
     steps, walkers, _ = kept.shape
     flat = kept.reshape(-1, kept.shape[-1])
