@@ -139,7 +139,7 @@ def observed(model: MinistackModel, T: NDArray, run: RunEnvelope) -> NDArray[np.
         return T
     gain = np.asarray(model.sensor_gain, dtype=float)
     tau = np.asarray(model.sensor_delay_s, dtype=float)
-    turn = np.exp(1j * delay_reference(run.row) * tau)  # a voltage's A_c holds the delay at w_c
+    turn = np.exp(1j * delay_reference(run.row) * tau) if np.any(tau) else 1.0  # a voltage's A_c holds it at w_c
     return run.equivalent_base * turn * (T - gain * np.exp(-2j * np.pi * run.f_hz * tau))
 
 
