@@ -275,11 +275,14 @@ def test_a_pairs_fingerprints_name_what_both_effects_share_once():
 
 
 def test_a_voltage_drives_lead_is_the_single_that_scores_best_on_the_drive_refit_with_it(monkeypatch):
-    """Every single effect that fits the runs better than the baseline (E on all runs) has the drive's slope refit
+    """Every single effect that fits the runs better than the baseline (E on all runs), or scores better, has the
+    drive's slope refit
     with it and is scored again on that drive; the lead is the best there. The stand-ins replay the voltage campaign
     hiding a channel delay: on the baseline's drive the neighbouring mode scores best (1.8) and the delay no better
     than the baseline (2.4 against 2.3), though it fits better (E 1.85 against 2.07); each on its own drive the delay
-    scores 1.2 and the neighbour 1.4. A single that fits no better (cubic, E 2.10) is not refit."""
+    scores 1.2 and the neighbour 1.4. A single that neither fits nor scores better (cubic, E 2.10, 2.5) is not refit;
+    one that scores better though it fits no better (settling, E 2.09, 2.2) is (the stage asks when a single scores
+    better, so there is always one)."""
     from types import SimpleNamespace
 
     from jointcal.discrepancy import stage
@@ -288,7 +291,7 @@ def test_a_voltage_drives_lead_is_the_single_that_scores_best_on_the_drive_refit
     from tests._support.beam_runs import BEAM, BEAM_JOINT, beam_space
 
     first = {"baseline": (2.3, 2.07), "neighbour_mode": (1.8, 1.49), "channel_delay": (2.4, 1.85),
-             "cubic_stiffening": (2.5, 2.10)}
+             "cubic_stiffening": (2.5, 2.10), "joint_settling": (2.2, 2.09)}
     seen = _stand_ins(monkeypatch, 0.5, {n: sc for n, (sc, _) in first.items()},
                       own={"channel_delay": 1.2, "neighbour_mode": 1.4})
     space = beam_space()
@@ -301,9 +304,10 @@ def test_a_voltage_drives_lead_is_the_single_that_scores_best_on_the_drive_refit
     lead, gain, runs, info = stage._lead_on_its_drive(
         "beam", space, BEAM.m, BEAM_JOINT, DiscrepancySettings(), stage._Clock(), said.append, None, scored,
         READ_OUT_GAIN, lambda g: [SimpleNamespace(gain=g)])
-    assert [name for name, *_ in seen["refits"]] == ["neighbour_mode", "channel_delay"]  # by first-pass score
+    # by first-pass score; settling fits no better (E 2.09) but scores better (2.2): refit too
+    assert [name for name, *_ in seen["refits"]] == ["neighbour_mode", "joint_settling", "channel_delay"]
     assert all(g == READ_OUT_GAIN for _, g, _ in seen["refits"])  # each from the baseline's drive
     assert lead.name == "channel_delay" and lead.score == 1.2
-    assert gain == seen["refits"][1][2] and runs[0].gain == gain
+    assert gain == seen["refits"][2][2] and runs[0].gain == gain
     assert complex(*info["relative_slope_refined"]) == pytest.approx(gain[1] * gain[2] / gain[0])
-    assert len(said) == 2 and "2.40 -> 1.20" in said[1]
+    assert len(said) == 3 and "2.40 -> 1.20" in said[2]

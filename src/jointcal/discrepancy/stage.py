@@ -310,8 +310,9 @@ def _score_singles(assembly, space, m, theta0, settings, clock, say, scales, run
 
 
 def _lead_on_its_drive(assembly, space, m, theta0, settings, clock, say, scales, scored, gain, build):
-    """A voltage drive: each single effect that fits the runs better than the baseline (E on all runs), the drive's
-    slope refit with it (`refine_slope`) and scored again on that drive; the best, as (scored, gain, runs, slope info).
+    """A voltage drive: each single effect that fits the runs better than the baseline (E on all runs) or scores
+    better, the drive's slope refit with it (`refine_slope`) and scored again on that drive; the best, as (scored,
+    gain, runs, slope info). The stage asks only when a single scores better, so there is always one to refit.
 
     The coil's slope refit with the baseline takes up what of an effect it can: a channel delay's phase slope, as
     much as the coil's magnitude tilt lets it (on the jointed beam hiding a 400 us delay: x 0.32 against the
@@ -320,7 +321,8 @@ def _lead_on_its_drive(assembly, space, m, theta0, settings, clock, say, scales,
     each on its own drive, the delay scored 1.21 against the neighbour's 1.42."""
     base = next(s for s in scored if s.name == "baseline")
     best = None
-    for s in sorted((s for s in scored if s.name != "baseline" and s.fit.E < base.fit.E), key=lambda s: s.score):
+    tried = (s for s in scored if s.name != "baseline" and (s.fit.E < base.fit.E or s.score < base.score))
+    for s in sorted(tried, key=lambda s: s.score):
         c = candidate(s.name, space, m, scales)
         g, runs, info = refine_slope(c, s.fit.theta, gain, build, max_nfev=settings.max_nfev)
         # a drive the effect leaves where it was: its score stands
