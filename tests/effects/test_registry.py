@@ -185,3 +185,22 @@ def test_each_kind_tries_its_own_library():
     assert set(library("modal")) == {"channel_delay", "cubic_stiffening", "joint_settling", "elastic_softening",
                                      "neighbour_mode"}
     assert "sensor_gain" in library("ministack") and "elastic_softening" not in library("ministack")
+
+
+def test_the_neighbours_shaker_loop_is_fitted_on_voltage_sweeps_only():
+    """neighbour_mode's loop constants are parameters where the sweeps are voltage-driven (scales["voltage"]) and
+    nowhere else; with them zero its model is the added mode, with them set the neighbour sits in the loop."""
+    from jointcal.effects import EFFECTS
+    from tests._support.rigs import rig
+
+    e = EFFECTS["neighbour_mode"]
+    scales = {"K0": 1022.0, "f0": 100.0, "q": 0.01}
+    assert [p.name for p in e.params_for(scales)] == ["f_ratio", "mode_ratio"]
+    assert [p.name for p in e.params_for(None)] == ["f_ratio", "mode_ratio"]
+    assert [p.name for p in e.params_for({**scales, "voltage": 1.0})] == ["f_ratio", "mode_ratio", "loop_armature",
+                                                                          "loop_back_emf", "read_gain", "read_phase"]
+    model = rig()[0]
+    plain = e.apply(model, {"f_ratio": 1.5, "mode_ratio": 4.0}, {})
+    looped = e.apply(model, {"f_ratio": 1.5, "mode_ratio": 4.0, "loop_armature": 0.05, "loop_back_emf": 0.01}, {})
+    assert not plain.neighbour.looped and looped.neighbour.looped
+    assert looped.neighbour.f_ref_hz == pytest.approx(model.f0_hz, rel=1e-12)

@@ -146,6 +146,7 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
     kind = str(best.get("model_kind", "ministack"))
     settings = replace(settings, candidates=tuple(n for n in settings.candidates if kind in EFFECTS[n].kinds))
     scales = structure_scales(best, modal[modal["assembly"] == assembly]) if kind != "ministack" else None
+    voltage = level_column(modal.columns) == LEVEL["voltage"]
     gain = drive_gain(modal[modal["assembly"] == assembly]) if level_column(modal.columns) != LEVEL["base"] else None
     if gain is not None:  # a force or voltage drives the mode through the campaign's modal constant
         rows = [{**r, "drive_gain": gain} for r in rows]
@@ -159,6 +160,8 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
                                vkw=dict(envelopes_kw=envelopes_kw, modal_kw=modal_kw, executor=executor),
                                metric_before=metric_before, frames_before=frames_before, joint_starts=joint_starts,
                                log=say)
+    if voltage and scales is not None:  # the sweeps' shaker loop: a neighbouring mode sits in it (`neighbour_mode`)
+        scales = {**scales, "voltage": 1.0}
     theta0 = np.array([best[p] for p in PARAMS], dtype=float)
     vkw = dict(settings=validate_settings, envelopes_kw=envelopes_kw, modal_kw=modal_kw, executor=executor)
     if scale is None or frames_before is None:  # as the validation stage does: the calibrated model in time

@@ -52,6 +52,7 @@ class EffectParam:
     start: float
     meaning: str
     grid: int = 0
+    voltage: bool = False  # only on a voltage-driven campaign's sweeps (the shaker's loop: scales["voltage"])
 
     def __post_init__(self) -> None:
         if self.grid < 0 or self.grid == 1:
@@ -89,12 +90,14 @@ class Effect:
 
     def params_for(self, scales: Mapping[str, float] | None = None) -> tuple[EffectParam, ...]:
         """Its parameters, their ranges and starts set by `rescale` for a structure of the given scales
-        (none given, or no `rescale`: the library's own, the Ministack's)."""
+        (none given, or no `rescale`: the library's own, the Ministack's); a `EffectParam.voltage` one only
+        where the scales say the sweeps are voltage-driven (``scales["voltage"]``)."""
+        params = tuple(p for p in self.params if not p.voltage or (scales or {}).get("voltage"))
         if not scales or self.rescale is None:
-            return self.params
+            return params
         new = self.rescale(scales)
         return tuple(replace(p, lo=new[p.name][0], hi=new[p.name][1], start=new[p.name][2]) if p.name in new else p
-                     for p in self.params)
+                     for p in params)
 
     @property
     def defaults(self) -> dict[str, float]:

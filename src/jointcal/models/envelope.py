@@ -31,7 +31,7 @@ sweep) and the quadrature `GAUSS_NODES`, `GAUSS_WEIGHTS`.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields as dataclass_fields
 from typing import Literal
 
 import numpy as np
@@ -95,6 +95,8 @@ def batch_shape(model: MinistackModel, f_shape: tuple) -> tuple[tuple[int, int],
         fields += [iw.Fs, iw.KT, iw.chi, iw.beta]
     if model.fixture is not None:
         fields += [model.fixture.m_can, model.fixture.f_can, model.fixture.zeta_can]
+    if model.neighbour is not None:
+        fields += [getattr(model.neighbour, f.name) for f in dataclass_fields(model.neighbour)]
     out_shape = np.broadcast_shapes(*(np.shape(v) for v in fields), f_shape)
     return (int(np.prod(out_shape[:-1], dtype=int)), out_shape[-1]), out_shape
 
@@ -160,9 +162,19 @@ def _structure_terms(model: MinistackModel, w: NDArray, shape) -> tuple[NDArray,
     Rigid base: mu = m omega^2, gamma = 1. Fixture (can DOF w = x_can - x_base between the
     base and the joint; M = [[m_can + m, m], [m, m]], K = diag(k_can, K_z)): condensing
     the can's row, a11 = k_can + i omega c_can - omega^2 (m_can + m), gives
-    mu = omega^2 m (1 + omega^2 m / a11) and gamma = (k_can + i omega c_can) / a11.
+    mu = omega^2 m (1 + omega^2 m / a11) and gamma = (k_can + i omega c_can) / a11. A voltage
+    drive's shaker loop around a neighbouring mode (`Neighbour.loop`, (N2)): mu = m omega^2
+    (1 - delta) and gamma = gamma_loop / kappa.
     """
     m = batch_field(model.m, shape)[:, None]
+    nb = model.neighbour
+    if nb is not None and nb.looped:  # a voltage drive's shaker loop around the neighbour (`Neighbour.loop`, (N2))
+        if model.fixture is not None:
+            raise ValueError("a neighbouring mode in a shaker's loop is a voltage-driven structure's (the modal "
+                             "model kind); the Ministack's fixture model has no such loop.")
+        nb = nb.batched(lambda v: batch_field(v, shape)[:, None])
+        gamma, delta = nb.loop(w / (2 * np.pi))
+        return m * w**2 * (1.0 - delta), gamma / nb.kappa  # the drive factor g of F = -g m
     if model.fixture is None:
         return m * w**2, None  # real inertia, unit load factor
     fx = model.fixture
@@ -227,7 +239,7 @@ def steady_state(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike = 1.0
     w = 2 * np.pi * f
     m = batch_field(model.m, shape)
     mu, gamma = _structure_terms(model, w, shape)
-    rigid = model.fixture is None  # gamma = 1, mu real: skip the complex work
+    rigid = gamma is None  # gamma = 1, mu real: skip the complex work
     s, jump, kre, kim = sweep_amplitudes(f, A, direction, shape, joint_terms(model, shape), m, mu, gamma)
     mu_re = np.ascontiguousarray(mu.real)
     q = np.exp(s)
@@ -238,6 +250,11 @@ def steady_state(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike = 1.0
         T = np.empty((P, f.size), complex)
         _k.rigid_output(kre, kim, mu_re, np.ascontiguousarray(m[:, None] * A * np.ones((1, f.size))), w, A,
                         gain, tau, Z, T)
+    elif model.fixture is None:  # the shaker's loop (N2): the channel reads 1 + gamma (rel + N' / kappa)
+        Z = -gamma * m[:, None] * A / (kre + 1j * kim - mu)  # here gamma is g = gamma / kappa (`_structure_terms`)
+        nb = model.neighbour.batched(lambda v: batch_field(v, shape)[:, None])
+        k = nb.kappa
+        T = gain[:, None] * (1.0 + gamma * k * (-w**2 * Z / A + nb.frf(f) / k)) * np.exp(-1j * w * tau[:, None])
     else:
         Kz = kre + 1j * kim
         Z = -gamma * m[:, None] * A / (Kz - mu)
@@ -250,7 +267,7 @@ def steady_state(model: MinistackModel, f_hz: ArrayLike, base_g: ArrayLike = 1.0
         W = (-(m_can + m[:, None]) * A + w**2 * m[:, None] * Z) / a11  # can row: a11 W - omega^2 m Z = -(m_can+m) A
         T = gain[:, None] * (1.0 - w**2 * (W + Z) / A) * np.exp(-1j * w * tau[:, None])
     nb = model.neighbour
-    if nb is not None:  # a neighbouring linear mode the response channel also reads (`structure.Neighbour`)
+    if nb is not None and not nb.looped:  # a neighbouring linear mode the response channel also reads (`structure.Neighbour`)
         T = T + gain[:, None] * np.exp(-1j * w * tau[:, None]) * Neighbour(
             batch_field(nb.f_hz, shape)[:, None], batch_field(nb.ratio, shape)[:, None], batch_field(nb.zeta, shape)[:, None]).frf(f)
     return SteadyState(T.reshape(out_shape), Z.reshape(out_shape), q.reshape(out_shape), jump.reshape(out_shape))

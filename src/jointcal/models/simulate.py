@@ -170,6 +170,9 @@ def simulate(model: MinistackModel, base_accel_g: ArrayLike, fs: float, *,
     if not fs > 0:
         raise ValueError(f"simulate: sample rate must be positive, got {fs!r}.")
     n_out, u_in = u.size, u
+    nb = model.neighbour
+    if nb is not None and nb.looped and complex(nb.kappa) != 1.0:  # the mode's own drive: the read-out's / kappa
+        u = np.ascontiguousarray(turned(u, 1.0 / complex(nb.kappa), fs))
     U = 1
     if samples_per_cycle is not None:
         u, U = band_limited(u, fs, model.f0_hz, samples_per_cycle)
@@ -179,12 +182,24 @@ def simulate(model: MinistackModel, base_accel_g: ArrayLike, fs: float, *,
     y = Y[0]
     if U > 1:
         y, z, fs = y[::U][:n_out].copy(), z[::U][:n_out].copy(), fs / U
-    if model.neighbour is not None:
-        y = y + neighbour_response(model.neighbour, u_in, fs)
+    if nb is not None and nb.looped:  # in the state space: the channel reads the read-out's drive, not the mode's
+        y = y - u[::U][:n_out] + u_in
+    elif nb is not None:
+        y = y + neighbour_response(nb, u_in, fs)
     if model.sensor_delay_s != 0.0:
         y = fractional_delay(y, model.sensor_delay_s, fs)
     y *= model.sensor_gain / G
     return SimResult(response_g=y, z_in=z, n_sub=n_sub * U)
+
+
+def turned(u: NDArray, factor: complex, fs: float) -> NDArray[np.float64]:
+    """The record u (sampled at fs, Hz) with every line of its spectrum multiplied by the complex constant
+    factor (its conjugate at negative frequencies): a gain and a phase shift, the same at every frequency,
+    applied on the spectrum zero-padded to twice the record's length."""
+    n = 1 << int(np.ceil(np.log2(2 * u.size)))
+    U = np.fft.rfft(u, n) * factor
+    U[0] = U[0].real * abs(factor)  # the mean is real: scaled, not turned
+    return np.fft.irfft(U, n)[:u.size]
 
 
 def neighbour_response(nb: Neighbour, u: NDArray, fs: float) -> NDArray[np.float64]:

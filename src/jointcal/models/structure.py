@@ -21,7 +21,8 @@ their signatures), a sensor one (gain, delay) on the output channel after integr
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from collections.abc import Callable
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -72,6 +73,25 @@ class Neighbour:
     w_n = 2 pi ``f_hz``: the modelled mode's own form with ``ratio`` times its modal constant (a residual
     mode above the band reads as a mass line, one below as a stiffness line). Fields may be batched (P, 1).
 
+    On a voltage drive the shaker's armature and back-EMF load the driving point, and so the
+    neighbour's motion as well as the mode's: the neighbour is then not a term added to the
+    response. With the sensor at the driving point, both modes' accelerations in units of the
+    drive (N' = `frf`, T_s the mode alone), the shaker's loop adds c' to the inverse of their sum,
+
+        Y / e = 1 / (1 / (T_s + N') + c'),    c' = -``armature`` + i ``back_emf`` w_r / w,  (N1)
+
+    ``armature`` the armature's share of the loaded mode's mass and ``back_emf`` the back-EMF's
+    damping 2 zeta_e at w_r = 2 pi ``f_ref_hz`` (the coil's own lag, x = w L / R, is left out: x^2
+    under 1% on the rigs read so far). The mode the calibration holds is already the loaded one,
+    1 / T = 1 / T_s + c', so (N1) is that mode with an added dynamic stiffness and drive
+    (`loop`), exact at the mode's amplitude for a nonlinear joint too. Both zero (a force drive:
+    the gauge measures the force, the shaker is outside the FRF): (N1) is T + N'.
+
+    The drive e is the read-out's, the campaign's modal constant from a one-mode fit of each record
+    (`jointcal.validate.drive`). Beside a looped neighbour that fit reads the wrong constant (the
+    jointed beam's voltage rig with a second mode at 150 Hz: 33% high, 4 deg), so the mode's own drive
+    is e / kappa, kappa = ``read_gain`` exp(i ``read_phase``) the read-out's constant over the mode's.
+
     Parameters
     ----------
     f_hz : float
@@ -80,16 +100,60 @@ class Neighbour:
         Its modal constant over the modelled mode's (signed, -).
     zeta : float
         Its damping ratio.
+    armature, back_emf : float
+        The shaker loop's constants of (N1), - (0: no loop).
+    f_ref_hz : float
+        Where ``back_emf`` is taken, Hz (the mode's stuck-joint frequency).
+    read_gain, read_phase : float
+        kappa's magnitude (-) and phase (rad): the read-out's drive constant over the mode's own.
     """
 
     f_hz: float
     ratio: float
     zeta: float = 0.01
+    armature: float = 0.0
+    back_emf: float = 0.0
+    f_ref_hz: float = 1.0
+    read_gain: float = 1.0
+    read_phase: float = 0.0
 
     def frf(self, f: NDArray) -> NDArray[np.complex128]:
         """Relative acceleration over base acceleration at frequencies f (Hz), shape broadcast(fields, f)."""
         wn, w = 2 * np.pi * np.asarray(self.f_hz, float), 2 * np.pi * np.asarray(f, float)
         return np.asarray(self.ratio, float) * w**2 / (wn**2 - w**2 + 2j * np.asarray(self.zeta, float) * wn * w)
+
+    @property
+    def looped(self) -> bool:
+        """Whether the shaker's loop (N1) acts or the read-out's constant is not the mode's (a voltage drive)."""
+        return bool(np.any(np.asarray(self.armature) != 0) or np.any(np.asarray(self.back_emf) != 0)
+                    or np.any(np.asarray(self.read_gain) != 1) or np.any(np.asarray(self.read_phase) != 0))
+
+    def batched(self, field: Callable[[ArrayLike], NDArray]) -> Neighbour:
+        """The same neighbour with each field passed through `field` (e.g. broadcast to a batch (P, 1))."""
+        return Neighbour(*(field(getattr(self, f.name)) for f in fields(self)))
+
+    @property
+    def kappa(self) -> NDArray[np.complex128]:
+        """The read-out's drive constant over the mode's own, read_gain exp(i read_phase)."""
+        return np.asarray(self.read_gain, float) * np.exp(1j * np.asarray(self.read_phase, float))
+
+    def loop(self, f: NDArray) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
+        """The loaded mode's drive factor gamma and added dynamic stiffness delta of (N1) at f (Hz).
+
+        With T the loaded mode's relative acceleration (the calibration's) driven by gamma e / kappa and
+        with its inverse 1 / T = (K_z - m w^2) / (m w^2) raised by delta (an added stiffness delta m w^2),
+
+            gamma = 1 / (1 + c' N'),  delta = -c'^2 N' / (1 + c' N'),  Y / e = gamma (T + N' / kappa).  (N2)
+
+        Returns
+        -------
+        gamma, delta : ndarray of complex, shape broadcast(fields, f)
+        """
+        f = np.asarray(f, float)
+        c = -np.asarray(self.armature, float) + 1j * np.asarray(self.back_emf, float) * np.asarray(self.f_ref_hz,
+                                                                                                     float) / f
+        cn = c * self.frf(f)
+        return 1.0 / (1.0 + cn), -c * cn / (1.0 + cn)
 
 
 @dataclass(frozen=True)
@@ -169,11 +233,37 @@ class StateSpace:
     extra: dict = field(default_factory=dict)
 
 
+def _loop_matrices(model: MinistackModel, ks: float, c: float) -> tuple[NDArray, ...]:
+    """M, C, K, the drive's Mb and the joint's ez of the mode (relative z) and its neighbour (relative y) in a
+    voltage drive's shaker loop (`Neighbour`, (N1)), both driven by F = u + mu_a (z'' + y'') + beta w_r (z' + y')
+    (the loop's c' in time: c' a = -mu_a a + beta w_r v):
+
+        m z'' + c z' + K z + r_nl = -m u - m (mu_a y'' + beta w_r y')      (the calibrated, loaded mode)
+        y'' + 2 zeta_n w_n y' + w_n^2 y = -r F                               (the neighbour, ratio r)
+
+    The first row is the loaded mode's: its mass and dashpot hold the armature and back-EMF acting on its
+    own motion (1 / T = 1 / T_s + c'), and the loop couples it to the neighbour's. u is the mode's own
+    drive, the read-out's over kappa (`Neighbour.kappa`; `simulate` turns the record)."""
+    if model.fixture is not None:
+        raise ValueError("a neighbouring mode in a shaker's loop is a voltage-driven structure's (the modal model "
+                         "kind); the Ministack's fixture model has no such loop.")
+    nb, m = model.neighbour, model.m
+    wn, wr = 2 * np.pi * float(nb.f_hz), 2 * np.pi * float(nb.f_ref_hz)
+    r, mu, b = float(nb.ratio), float(nb.armature), float(nb.back_emf) * wr
+    M = np.array([[m, m * mu], [r * mu, 1.0 + r * mu]])
+    C = np.array([[c, m * b], [r * b, 2 * float(nb.zeta) * wn + r * b]])
+    K = np.diag([ks, wn**2])
+    return M, C, K, np.array([m, r]), np.array([1.0, 0.0])
+
+
 def state_space(model: MinistackModel) -> StateSpace:
     """Assemble the first-order linear system with the joint stuck (stiffness k + KT)."""
     m, ks = model.m, model.k + model.KT
     c = 2.0 * model.zeta_v * np.sqrt(ks * m)
-    if model.fixture is None:
+    nb = model.neighbour
+    if nb is not None and nb.looped:
+        M, C, K, Mb, ez = _loop_matrices(model, ks, c)
+    elif model.fixture is None:
         M = np.array([[m]])
         K = np.array([[ks]])
         C = np.array([[c]])

@@ -155,6 +155,8 @@ def _derivs(model: MinistackModel, w: NDArray, shape) -> tuple[NDArray, ...]:
     """
     m = _field(model.m, shape)[:, None]
     z = np.zeros((shape[0], w.size), complex)
+    if _looped(model):
+        return _loop_derivs(model, w, shape)
     if model.fixture is None:  # real values as complex arrays (P, N)
         out = [np.empty_like(z) for _ in range(4)]
         for o, v in zip(out, (m * w**2, 2 * m * w, 2 * m, -m)):
@@ -174,6 +176,37 @@ def _derivs(model: MinistackModel, w: NDArray, shape) -> tuple[NDArray, ...]:
     F1 = -m * (kc1 / a - kc * a1 / a_sq)
     F2 = -m * (-2 * kc1 * a1 / a_sq - kc * a2 / a_sq + 2 * kc * a1_sq / a_cube)
     return mu, mu1, mu2, F, F1, F2
+
+
+def _looped(model: MinistackModel) -> bool:
+    """Whether a voltage drive's shaker loop holds the model's neighbouring mode (`structure.Neighbour`, (N1))."""
+    return model.neighbour is not None and model.neighbour.looped
+
+
+def _neighbour(model: MinistackModel, shape) -> Neighbour:
+    """The model's neighbouring mode with its fields as (P, 1) arrays."""
+    return model.neighbour.batched(lambda v: _field(v, shape)[:, None])
+
+
+def _loop_derivs(model: MinistackModel, w: NDArray, shape) -> tuple[NDArray, ...]:
+    """`_derivs` of a rigid base with the shaker's loop around a neighbouring mode (`Neighbour.loop`, (N2)):
+    mu = m w^2 (1 - delta), F = -gamma m / kappa, their w-derivatives by central differences (step 1e-4 w; the
+    neighbour's half-power width is 2 zeta_n = 2% of its frequency, so the truncation is about 1e-4
+    of the second derivative's)."""
+    if model.fixture is not None:
+        raise ValueError("a neighbouring mode in a shaker's loop is a voltage-driven structure's (the modal model "
+                         "kind); the Ministack's fixture model has no such loop.")
+    m = _field(model.m, shape)[:, None]
+    nb = _neighbour(model, shape)
+
+    def terms(x):
+        gamma, delta = nb.loop(x / (2 * np.pi))
+        return m * x**2 * (1.0 - delta), -m * gamma / nb.kappa
+
+    h = 1e-4 * w
+    (mu, F), (mu_p, F_p), (mu_m, F_m) = terms(w), terms(w + h), terms(w - h)
+    return (mu, (mu_p - mu_m) / (2 * h), (mu_p - 2 * mu + mu_m) / h**2,
+            F, (F_p - F_m) / (2 * h), (F_p - 2 * F + F_m) / h**2)
 
 
 def _linearised(D: NDArray, Ks: NDArray, Z0: NDArray):
@@ -222,7 +255,7 @@ def _quasi_steady(model: MinistackModel, f: NDArray, base_g: NDArray, rate: NDAr
     m = _field(model.m, shape)
     joint = _joint_terms(model, shape) if joint is None else joint
     mu, mu1, mu2, F, F1, F2 = _derivs(model, w, shape)
-    gamma = None if model.fixture is None else -F / m[:, None]
+    gamma = None if model.fixture is None and not _looped(model) else -F / m[:, None]
     mu_joint = mu if gamma is not None else mu.real
     s, _, kre, kim = (_amplitudes(f, A, direction, shape, joint, m, mu_joint, gamma) if segments is None
                       else _segment_amplitudes(f, A, segments, shape, joint, m, mu_joint, gamma))
@@ -261,12 +294,18 @@ def _sensor(model: MinistackModel, f: NDArray, shape) -> NDArray:
 
 
 def _channel(model: MinistackModel, T: NDArray, f: NDArray, shape) -> NDArray:
-    """What the response channel reads of the joint DOF's T (P, N): a neighbouring mode added (linear, steady),
-    then the sensor's gain and delay."""
-    nb = model.neighbour
-    if nb is not None:
-        T = T + Neighbour(_field(nb.f_hz, shape)[:, None], _field(nb.ratio, shape)[:, None],
-                          _field(nb.zeta, shape)[:, None]).frf(f)
+    """What the response channel reads of the slug's absolute T = R / A (P, N): a neighbouring mode added
+    (linear, steady), then the sensor's gain and delay. In a shaker's loop (`Neighbour.loop`, (N2)) the
+    mode's relative acceleration is (T - g) / (1 - delta), g = gamma / kappa (the slug's balance
+    m w^2 (1 - delta) Z = K_z Z - F A, F = -g m: R = -K_z Z / m), and the channel reads
+    1 + gamma (that + N' / kappa)."""
+    if model.neighbour is not None:
+        nb = _neighbour(model, shape)
+        if nb.looped:
+            gamma, delta = nb.loop(f)
+            T = 1.0 + gamma * ((T - gamma / nb.kappa) / (1.0 - delta) + nb.frf(f) / nb.kappa)
+        else:
+            T = T + nb.frf(f)
     return T * _sensor(model, f, shape)
 
 
