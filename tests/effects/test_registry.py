@@ -198,9 +198,11 @@ def test_the_neighbours_shaker_loop_is_fitted_on_voltage_sweeps_only():
     assert [p.name for p in e.params_for(scales)] == ["f_ratio", "mode_ratio"]
     assert [p.name for p in e.params_for(None)] == ["f_ratio", "mode_ratio"]
     assert [p.name for p in e.params_for({**scales, "voltage": 1.0})] == ["f_ratio", "mode_ratio", "loop_armature",
-                                                                          "loop_back_emf", "read_gain", "read_phase"]
+                                                                          "back_emf_share", "read_gain", "read_phase"]
     model = rig()[0]
     plain = e.apply(model, {"f_ratio": 1.5, "mode_ratio": 4.0}, {})
-    looped = e.apply(model, {"f_ratio": 1.5, "mode_ratio": 4.0, "loop_armature": 0.05, "loop_back_emf": 0.01}, {})
+    looped = e.apply(model, {"f_ratio": 1.5, "mode_ratio": 4.0, "loop_armature": 0.05, "back_emf_share": 0.3},
+                     {})
     assert not plain.neighbour.looped and looped.neighbour.looped
     assert looped.neighbour.f_ref_hz == pytest.approx(model.f0_hz, rel=1e-12)
+    assert looped.neighbour.back_emf == pytest.approx(0.3 * 2 * model.zeta_v, rel=1e-12)  # a share of 2 zeta_v

@@ -21,7 +21,7 @@ joint_settling         Fs_drift (-), KT_drift (-), n_settle (runs)      Fs, KT r
 elastic_softening      loss_ratio (-)                                   joint force r F_iwan + (1 - r) F_b: its
                                                                         backbone, r of Masing's loss (modal only)
 neighbour_mode         f_ratio (-), mode_ratio (-); on voltage sweeps   a linear mode the channel also reads
-                       also loop_armature (-), loop_back_emf (-),       (modal only); on a voltage drive in the
+                       also loop_armature (-), back_emf_share (-),      (modal only); on a voltage drive in the
                        read_gain (-), read_phase (rad)                  shaker's loop, the read-out's constant off
 contact_spring         contact_k (lbf/in), gap_in (in)                  a stop beyond a gap (even harmonics);
                                                                         outside the discrepancy library
