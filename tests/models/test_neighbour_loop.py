@@ -131,3 +131,11 @@ def test_a_read_out_constant_off_the_modes_own_divides_the_drive():
     T = np.sum(y[last] * e) / np.sum(u[last] * e)
     expected = steady_state(replace(MODEL, neighbour=nbk), [99.0], 0.05).transmissibility[0]
     assert abs(T / expected - 1.0) < 1e-4, (T, expected)
+
+
+def test_a_loop_that_makes_the_rig_active_is_refused_in_time():
+    """A back-EMF damping above the mode's own viscous damping leaves the structure without the shaker a negative
+    dashpot: the time simulation refuses it in one sentence rather than integrating a growing response."""
+    bad = replace(MODEL, neighbour=replace(NB, back_emf=0.5))
+    with pytest.raises(ValueError, match="unstable"):
+        simulate(bad, np.zeros(64), 2048.0)

@@ -253,6 +253,12 @@ def _loop_matrices(model: MinistackModel, ks: float, c: float) -> tuple[NDArray,
     M = np.array([[m, m * mu], [r * mu, 1.0 + r * mu]])
     C = np.array([[c, m * b], [r * b, 2 * float(nb.zeta) * wn + r * b]])
     K = np.diag([ks, wn**2])
+    Minv = np.linalg.inv(M)
+    poles = np.linalg.eigvals(np.block([[np.zeros((2, 2)), np.eye(2)], [-Minv @ K, -Minv @ C]]))
+    if np.any(poles.real > 0):
+        raise ValueError(f"the neighbour's shaker loop (armature {mu:g}, back-EMF 2 zeta_e {float(nb.back_emf):g}, "
+                         f"ratio {r:g}) makes the stuck model unstable: the back-EMF must not exceed the mode's own "
+                         "viscous damping (2 zeta_v), the armature's share and the ratio must lie in [0, 1) and >= 0.")
     return M, C, K, np.array([m, r]), np.array([1.0, 0.0])
 
 
