@@ -206,3 +206,7 @@ def test_the_neighbours_shaker_loop_is_fitted_on_voltage_sweeps_only():
     assert not plain.neighbour.looped and looped.neighbour.looped
     assert looped.neighbour.f_ref_hz == pytest.approx(model.f0_hz, rel=1e-12)
     assert looped.neighbour.back_emf == pytest.approx(0.3 * 2 * model.zeta_v, rel=1e-12)  # a share of 2 zeta_v
+    loop_words = e.advice({"f_ratio": 1.5, "mode_ratio": 4.0, "loop_armature": 0.047, "back_emf_share": 0.35,
+                           "read_gain": 1.31, "read_phase": -0.05})
+    assert "armature (0.047" in loop_words and "0.35 of its viscous damping" in loop_words and "1.310 x" in loop_words
+    assert "armature" not in e.advice({"f_ratio": 1.5, "mode_ratio": 4.0})
