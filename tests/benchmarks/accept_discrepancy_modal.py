@@ -357,6 +357,10 @@ channel_delay's seed 1 and was named there in the delay's place: neighbour 1.21 
     channel_delay                        voltage  seed 3: channel_delay                        high   E   4.27 ->  0.90 ( -79%) stage 79 s
     elastic_softening                    voltage  seed 1: elastic_softening                    high   E   5.96 ->  0.69 ( -88%) stage 143 s
     cubic_stiffening                     voltage  seed 1: cubic_stiffening                     high   E   9.12 ->  0.65 ( -93%) stage 90 s
+    elastic_softening                    voltage  seed 2: elastic_softening                    high   E   5.86 ->  0.69 ( -88%) stage 166 s
+    elastic_softening                    voltage  seed 3: elastic_softening                    high   E   5.92 ->  0.68 ( -89%) stage 148 s
+    cubic_stiffening                     voltage  seed 2: cubic_stiffening                     high   E   9.16 ->  0.63 ( -93%) stage 94 s
+    cubic_stiffening                     voltage  seed 3: cubic_stiffening                     high   E   9.05 ->  0.61 ( -93%) stage 105 s
     elastic_softening+cubic_stiffening   voltage  seed 1: cubic_stiffening+elastic_softening   high   E   6.98 ->  0.69 ( -90%) stage 384 s
     elastic_softening+cubic_stiffening   voltage  seed 2: cubic_stiffening                     high   E   7.16 ->  0.94 ( -87%) stage 186 s
     elastic_softening+cubic_stiffening   voltage  seed 3: cubic_stiffening+elastic_softening   high   E   7.39 ->  0.74 ( -90%) stage 243 s
