@@ -18,7 +18,7 @@ fit of T1 alone within 5% of the resonance, as the campaign's modal constant is 
 library's read_gain / read_phase fitted. Measured 2026-11-27 (150 Hz, 0.25 lbf):
 
     loop, drive constant free          E 0.016 (f_n 1.54 f1, ratio 4.32, armature 0.048, back-EMF 0.0090)
-    loop, the read-out's constant      E 4.79  (the read-out is 33% high and 4 deg off the mode's own)
+    loop, the read-out's constant      E 4.79  (the read-out is 32% high and 4 deg off the mode's own)
     loop, read-out's, read_gain/phase  E 0.016 (read_gain 1.320, read_phase +4.3 deg)
 """
 import sys

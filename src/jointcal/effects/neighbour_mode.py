@@ -26,7 +26,7 @@ back-EMF free in 2 zeta_e took 0.48 (against the mode's 0.025) on a campaign wit
 delay, and the loop's phase then stood in for the delay's. Fitted to the exact linear
 FRF of the jointed beam's voltage rig with a second mode at 150 Hz (`tests/models/
 test_neighbour_loop.py`), the added term leaves E 5.1 and the loop 0.008. And the campaign's drive
-constant, read by a one-mode fit of each record, is not the mode's beside such a neighbour (33% high
+constant, read by a one-mode fit of each record, is not the mode's beside such a neighbour (32% high
 and 4 deg on that rig; with it held, the loop's fit leaves E 4.8): read_gain and read_phase are the
 read-out's constant over the mode's. The loop reads the driving point, where the neighbour's modal
 constant is a square: its ratio is then 0..10. A force reference measures the force the shaker gives, so its

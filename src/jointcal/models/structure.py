@@ -89,7 +89,7 @@ class Neighbour:
 
     The drive e is the read-out's, the campaign's modal constant from a one-mode fit of each record
     (`jointcal.validate.drive`). Beside a looped neighbour that fit reads the wrong constant (the
-    jointed beam's voltage rig with a second mode at 150 Hz: 33% high, 4 deg), so the mode's own drive
+    jointed beam's voltage rig with a second mode at 150 Hz: 32% high, 4 deg), so the mode's own drive
     is e / kappa, kappa = ``read_gain`` exp(i ``read_phase``) the read-out's constant over the mode's.
 
     Parameters
