@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.linalg import expm
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from . import _integrator
 from ..units import G
@@ -192,26 +192,25 @@ def simulate(model: MinistackModel, base_accel_g: ArrayLike, fs: float, *,
     return SimResult(response_g=y, z_in=z, n_sub=n_sub * U)
 
 
+def _through(u: NDArray, H: Callable[[NDArray], NDArray], fs: float) -> NDArray[np.float64]:
+    """The record u (sampled at fs, Hz) through the frequency response H(f), line by line on its spectrum
+    zero-padded to twice its length (a ringing does not wrap): exact for the band-limited record a DAQ
+    takes, as the drive's gain is applied (`jointcal.validate.drive`)."""
+    n = 1 << int(np.ceil(np.log2(2 * u.size)))
+    return np.fft.irfft(np.fft.rfft(u, n) * H(np.fft.rfftfreq(n, 1.0 / fs)), n)[:u.size]
+
+
 def turned(u: NDArray, factor: complex, fs: float) -> NDArray[np.float64]:
     """The record u (sampled at fs, Hz) with every line of its spectrum multiplied by the complex constant
-    factor (its conjugate at negative frequencies): a gain and a phase shift, the same at every frequency,
-    applied on the spectrum zero-padded to twice the record's length."""
-    n = 1 << int(np.ceil(np.log2(2 * u.size)))
-    U = np.fft.rfft(u, n) * factor
-    U[0] = U[0].real * abs(factor)  # the mean is real: scaled, not turned
-    return np.fft.irfft(U, n)[:u.size]
+    factor (its conjugate at negative frequencies): a gain and a phase shift, the same at every frequency
+    (the mean, real, only scaled)."""
+    return _through(u, lambda f: np.where(f > 0, factor, abs(factor)), fs)
 
 
 def neighbour_response(nb: Neighbour, u: NDArray, fs: float) -> NDArray[np.float64]:
     """Relative acceleration of a neighbouring linear mode (`structure.Neighbour`) driven by the base
-    acceleration u (any unit; the same out), sampled at fs (Hz).
-
-    Applied line by line to the record's spectrum (zero-padded to twice its length, so the mode's ringing
-    does not wrap): exact for the band-limited record a DAQ takes, as the drive's gain is applied
-    (`jointcal.validate.drive`).
-    """
-    n = 1 << int(np.ceil(np.log2(2 * u.size)))
-    return np.fft.irfft(np.fft.rfft(u, n) * nb.frf(np.fft.rfftfreq(n, 1.0 / fs)), n)[:u.size]
+    acceleration u (any unit; the same out), sampled at fs (Hz): its FRF applied by `_through`."""
+    return _through(u, nb.frf, fs)
 
 
 def _joint(iwan: IwanParams | None, sliders: tuple[NDArray, NDArray] | None = None) -> tuple:
