@@ -43,6 +43,29 @@ def test_no_effect_gives_none():
     assert name == "none"
 
 
+def test_on_a_pool_the_scores_and_the_recalibration_are_the_serial_ones():
+    """The stage spreads the candidates' fits, and each batch of the GA and the chain, over its process pool: the
+    numbers must be those of the serial run, to the bit (each candidate's fit and each parameter set's residuals
+    are their own)."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    from jointcal.discrepancy.recalibrate import recalibrate
+
+    runs = _runs("sensor_gain", [1.12], seed=5)
+    cands = [candidate(n, SPACE, M) for n in ("baseline", "sensor_gain", "channel_delay")]
+    with ProcessPoolExecutor(max_workers=2) as ex:
+        pooled = score_candidates(cands, runs, TRUTH, max_nfev=15, executor=ex)
+        named = next(s for s in pooled if s.name == "sensor_gain")
+        kw = dict(seed=3, generations=2, population=32, walkers=32, steps=60, max_nfev=10)
+        rec_pooled = recalibrate(cands[1], runs, [named.fit], executor=ex, **kw)
+    serial = score_candidates(cands, runs, TRUTH, max_nfev=15)
+    assert [(s.name, s.score, s.held_out) for s in pooled] == [(s.name, s.score, s.held_out) for s in serial]
+    assert all(np.array_equal(a.fit.theta, b.fit.theta) for a, b in zip(pooled, serial))
+    rec = recalibrate(cands[1], runs, [next(s for s in serial if s.name == "sensor_gain").fit], **kw)
+    pd.testing.assert_frame_equal(rec_pooled.quantiles, rec.quantiles, check_exact=True)
+    assert np.array_equal(rec_pooled.fit.theta, rec.fit.theta) and rec_pooled.ga_best_E == rec.ga_best_E
+
+
 def test_the_sweep_lag_is_not_mistaken_for_a_delay():
     """Envelopes seen through a fast sweep (first-order lag, opposite in up and down sweeps) with no effect."""
     runs = _runs(seed=4, rate=300.0)

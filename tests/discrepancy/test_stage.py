@@ -133,7 +133,7 @@ def _stand_ins(monkeypatch, floor: float, scores: dict[str, float], own: dict[st
         th = c.grown.vector(dict(zip(PARAMS, theta0[:len(PARAMS)])), default={p.name: p.start for p in c.effect_params})
         return Scored(name, Fit(name, th, score, 1e-4 * np.eye(c.grown.ndim), 1), score)
 
-    def score_singles(assembly, space, m, theta0, settings, clock, say, scales, runs, prev=None):
+    def score_singles(assembly, space, m, theta0, settings, clock, say, scales, ex, runs, prev=None):
         return [scored_as(name, theta0, space=space, m=m, scales=scales, score=score) for name, score in scores.items()]
 
     def score_on_own_drive(cands, runs, theta0, **kw):  # `_lead_on_its_drive`'s scoring: the same scores
@@ -152,7 +152,7 @@ def _stand_ins(monkeypatch, floor: float, scores: dict[str, float], own: dict[st
     ver = {n: {"for": [], "against": []} for n in scores}
     for name, fn in {"_usable_runs": usable_runs, "refine_slope": refine_slope, "_score_singles": score_singles,
                      "score_candidates": score_on_own_drive,
-                     "_add_pairs": lambda *a, **k: (a[9], []),
+                     "_add_pairs": lambda *a, **k: (a[10], []),
                      "_recalibrated": recalibrated, "validate_runs": validate_runs,
                      "fast_floor": lambda *a: {"E": floor, "per_level": {}},
                      "_localise": lambda *a: (pd.DataFrame(), fp, ver, None),
@@ -234,12 +234,12 @@ def test_forward_selection_judges_pairs_on_the_best_singles_slope(monkeypatch):
     singles = stage._score_singles
 
     def score_singles(*a, **k):
-        order.append(("singles", a[8][0].gain))
+        order.append(("singles", a[9][0].gain))
         return singles(*a, **k)
 
     def add_pairs(*a, **k):
-        order.append(("pairs", a[8][0].gain))
-        scored = a[9]
+        order.append(("pairs", a[9][0].gain))
+        scored = a[10]
         if len(order) > 3:  # the second forward selection: the pair's drive
             return scored, []
         from jointcal.discrepancy.fit import Fit
@@ -302,7 +302,7 @@ def test_a_voltage_drives_lead_is_the_single_that_scores_best_on_the_drive_refit
         scored.append(Scored(name, Fit(name, th, E, 1e-4 * np.eye(c.grown.ndim), 1), score))
     said = []
     lead, gain, runs, info = stage._lead_on_its_drive(
-        "beam", space, BEAM.m, BEAM_JOINT, DiscrepancySettings(), stage._Clock(), said.append, None, scored,
+        "beam", space, BEAM.m, BEAM_JOINT, DiscrepancySettings(), stage._Clock(), said.append, None, None, scored,
         READ_OUT_GAIN, lambda g: [SimpleNamespace(gain=g)])
     # by first-pass score; settling fits no better (E 2.09) but scores better (2.2): refit too
     assert [name for name, *_ in seen["refits"]] == ["neighbour_mode", "joint_settling", "channel_delay"]

@@ -218,7 +218,8 @@ def diagnose_decays(assembly: str, backbone: pd.DataFrame, modal: pd.DataFrame, 
         metric_before = float(v0.error["E"]) if metric_before is None else metric_before
     c0 = candidate("baseline", space, m, scales)
     folds = decay_folds(runs)
-    kw = dict(objective=DecayObjective, folds=folds, log=say, predictive=True)
+    ex = vkw.get("executor")  # the pool the revalidation uses: the candidates fitted side by side on it too
+    kw = dict(objective=DecayObjective, folds=folds, log=say, predictive=True, executor=ex)
     # every candidate from the calibration and from its other valleys: beta is held at the start's value, and the
     # Iwan alone made to follow a hardening backbone sits with its macroslip knee at the top amplitude, a valley a
     # hidden stiffening's model does not share (its read-out there is the knee's, not the backbone's)
@@ -256,7 +257,8 @@ def diagnose_decays(assembly: str, backbone: pd.DataFrame, modal: pd.DataFrame, 
         cf.grown.vector(dict(zip(PARAMS, map(float, th))), default=cf.grown.named(named.fit.theta)), starts=1,
         max_nfev=2 * settings.max_nfev) for th in joint_starts]
     rec = recalibrate(cf, runs, starts, seed=settings.seed, generations=settings.ga_generations,
-                      steps=settings.posterior_steps, max_nfev=2 * settings.max_nfev, objective=DecayObjective)
+                      steps=settings.posterior_steps, max_nfev=2 * settings.max_nfev, objective=DecayObjective,
+                      executor=ex)
     say(f"{assembly}: decision {decision.effect} ({decision.confidence}); {named.name} recalibrated, "
         f"E {rec.fit.E:.2f}; revalidating with the time simulation")
     v_after = validate_runs([model_at(cf, rec.fit.theta, r) for r in rows], records, rows, **vkw)

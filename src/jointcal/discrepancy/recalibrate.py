@@ -71,10 +71,27 @@ class Recalibration:
         return [float(self.quantiles.at[name, "q05"]), float(self.quantiles.at[name, "q95"])]
 
 
-def _posterior(obj: Objective, at: Fit, temperature: float) -> ResidualPosterior:
-    """E^2 of the objective as a posterior over its free columns, the held ones at `at`'s values."""
+def _in_halves(residuals, executor, min_rows: int = 8):
+    """`residuals` of a batch of parameter sets (P, n) -> (P, m) in two halves, the second on the executor (when
+    given) while this process computes the first. Always in halves, pool or not: numpy's vectorised exp and log
+    round an element by where it sits in its array (1e-14 apart), so a set's residuals are the same in a half
+    batch only as in the same half batch. Under 2 x min_rows sets: one call."""
+    def halves(theta):
+        th = np.asarray(theta, dtype=float)
+        if th.ndim < 2 or th.shape[0] < 2 * min_rows:
+            return residuals(th)
+        h = th.shape[0] // 2
+        other = executor.submit(residuals, th[h:]) if executor is not None else None
+        first = residuals(th[:h])
+        return np.concatenate([first, residuals(th[h:]) if other is None else other.result()])
+    return halves
+
+
+def _posterior(obj: Objective, at: Fit, temperature: float, executor=None) -> ResidualPosterior:
+    """E^2 of the objective as a posterior over its free columns, the held ones at `at`'s values (each batch in
+    halves over the executor, `_in_halves`)."""
     space = obj.candidate.grown
-    return ResidualPosterior(space, obj.residuals, obj.residuals(at.theta).size,
+    return ResidualPosterior(space, _in_halves(obj.residuals, executor), obj.residuals(at.theta).size,
                              temperature, np.clip(space.to_unit(at.theta), 0.0, 1.0), space.free_mask(HELD))
 
 
@@ -97,23 +114,25 @@ def _chosen(fits: Sequence[Fit], c: Candidate, runs: Sequence, n_res: int) -> Fi
 
 def recalibrate(c: Candidate, runs: Sequence[RunEnvelope], starts: Sequence[Fit], *, seed: int = 2017,
                 population: int = 48, generations: int = 30, walkers: int = 32, steps: int = 800,
-                max_nfev: int = 50, objective=Objective) -> Recalibration:
+                max_nfev: int = 50, objective=Objective, executor=None) -> Recalibration:
     """GA + polish + emcee of candidate `c` on the runs' envelopes (see the module notes).
 
     starts : least-squares fits of `c` (e.g. from the calibration's optimum and other valleys)
     seeded into the GA's initial population. seed : seeds the GA and the sampler. objective : the
-    candidate's objective on the runs (the sweeps' `Objective`; ring-downs: `decays.DecayObjective`).
+    candidate's objective on the runs (the sweeps' `Objective`; ring-downs: `decays.DecayObjective`). executor :
+    a `concurrent.futures.Executor` that takes half of each batch of the GA and the chain (`_in_halves`: the same
+    numbers as without).
     """
     first = min(starts, key=lambda f: f.E)
     obj = objective(c, runs).at(first.theta)  # the sweep transient at the best start
-    lp = _posterior(obj, first, 1.0)
+    lp = _posterior(obj, first, 1.0, executor)
     init = np.array([np.clip(c.to_unit(f.theta), 0.0, 1.0)[lp.free] for f in starts]).reshape(-1, lp.ndim)
     options = GAOptions(population=population, offspring=population, generations=generations, stall_generations=8,
                         seed=seed)
     ga = search(lp.misfit_unit, c.grown, options, free=lp.free, at=lp.at, init=init)
     pol = obj.fit(lp.physical(ga.best[None])[0], starts=1, max_nfev=max_nfev, refresh=1)
     best = _chosen([pol, *starts], c, runs, obj.residuals(pol.theta).size)
-    lp = _posterior(obj.at(best.theta), best, max(best.E**2, 1.0))  # the chain holds beta at the chosen fit's value
+    lp = _posterior(obj.at(best.theta), best, max(best.E**2, 1.0), executor)  # the chain holds beta at the chosen fit's value
     # the Gauss-Newton width, within [0.003, 0.01] of the unit cube: a flat direction must not
     # start as a point, or the ensemble explores it too slowly
     sd = np.sqrt(np.clip(np.diag(best.cov_unit)[lp.free], 9e-6, 1e-4))

@@ -145,10 +145,23 @@ def _rms(values) -> float:
     return float(np.sqrt(np.mean(np.square(list(values))))) if len(values) else float("nan")
 
 
+def _fit_and_hold_out(c: Candidate, runs: Sequence[RunEnvelope], starts: Sequence[np.ndarray], max_nfev: int,
+                      folds: dict[str, list[int]], predictive: bool, objective) -> tuple[Fit, dict, float]:
+    """One candidate's fit on all runs (the lowest E from `starts`) and its held-out E per fold, and the seconds
+    they took: the part of `score_candidates` that is the candidate's alone."""
+    t0 = time.perf_counter()
+    obj = objective(c, runs)
+    fits = [obj.fit(start, starts=1 if c.name == "baseline" else 3, max_nfev=max_nfev, refresh=1) for start in starts]
+    full = min(fits, key=lambda f: f.E)
+    per = _held_out(obj.at(full.theta), full, max_nfev, folds, predictive) if folds else {}
+    return full, per, time.perf_counter() - t0
+
+
 def score_candidates(cands: Sequence[Candidate], runs: Sequence[RunEnvelope], theta_base, *,
                      max_nfev: int = 40, log=None, baseline: Scored | None = None,
                      starts: dict[str, Sequence[np.ndarray]] | None = None, objective=Objective,
-                     folds: dict[str, list[int]] | None = None, predictive: bool = False) -> list[Scored]:
+                     folds: dict[str, list[int]] | None = None, predictive: bool = False,
+                     executor=None) -> list[Scored]:
     """Fit every candidate on all runs, then score it on held-out folds (see the module notes).
 
     The baseline is scored first (added if `cands` lacks it and `baseline` is not given): the
@@ -158,7 +171,9 @@ def score_candidates(cands: Sequence[Candidate], runs: Sequence[RunEnvelope], th
     the fit from each is made and the lowest E on all runs kept (default: theta_base). objective : the
     objective of a candidate on the runs (the sweeps' `Objective`; ring-downs: `decays.DecayObjective`);
     folds : the held-out folds (default: the sweeps' levels, directions and rates, `_folds`); predictive :
-    each fold's E as its predictive deviance (`predictive_E`; an objective with ``weights``).
+    each fold's E as its predictive deviance (`predictive_E`; an objective with ``weights``). executor : a
+    `concurrent.futures.Executor` the candidates are fitted on, side by side (each candidate's fit is its own,
+    so the scores are those of the serial run, None).
     """
     cands = sorted(cands, key=lambda c: c.name != "baseline")
     if baseline is None and (not cands or cands[0].name != "baseline"):
@@ -166,13 +181,15 @@ def score_candidates(cands: Sequence[Candidate], runs: Sequence[RunEnvelope], th
     folds = _folds(runs) if folds is None else folds
     out, base_per = [], (baseline.held_out if baseline is not None else {})
     base_score = baseline.score if baseline is not None else None
-    for c in cands:
-        t0 = time.perf_counter()
-        obj = objective(c, runs)
-        fits = [obj.fit(start, starts=1 if c.name == "baseline" else 3, max_nfev=max_nfev, refresh=1)
-                for start in (starts or {}).get(c.name, [theta_base])]
-        full = min(fits, key=lambda f: f.E)
-        per = _held_out(obj.at(full.theta), full, max_nfev, folds, predictive) if folds else {}
+    jobs = [(c, runs, (starts or {}).get(c.name, [theta_base]), max_nfev, folds, predictive, objective)
+            for c in cands]
+    if executor is not None and len(jobs) > 1:  # the candidates with the most parameters (the longest fits) first
+        futures = {i: executor.submit(_fit_and_hold_out, *jobs[i])
+                   for i in sorted(range(len(jobs)), key=lambda i: -len(cands[i].names))}
+        done = (futures[i].result() for i in range(len(jobs)))
+    else:
+        done = (_fit_and_hold_out(*j) for j in jobs)
+    for c, (full, per, seconds) in zip(cands, done):
         if c.name == "baseline":
             base_per = per
             s = _rms(per.values()) if per else full.E
@@ -184,7 +201,7 @@ def score_candidates(cands: Sequence[Candidate], runs: Sequence[RunEnvelope], th
         else:  # judged on a subset of the folds: relative to the baseline on the same subset
             s = base_score * _rms(per.values()) / _rms([base_per[k] for k in per])
         s *= 1.0 + PENALTY_PER_PARAM * (len(c.names) - 6)
-        out.append(Scored(c.name, full, s, per, time.perf_counter() - t0))
+        out.append(Scored(c.name, full, s, per, seconds))
         if log:
-            log(f"{c.name}: E on all runs {full.E:.2f}, held-out score {s:.2f} ({time.perf_counter() - t0:.1f} s)")
+            log(f"{c.name}: E on all runs {full.E:.2f}, held-out score {s:.2f} ({seconds:.1f} s)")
     return out

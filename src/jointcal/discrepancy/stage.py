@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import json
 import time
+from functools import partial
 from dataclasses import replace
 from collections.abc import Callable, Mapping, Sequence
 
@@ -187,9 +188,7 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
         say(f"{assembly}: the voltage drive's slope not refit: the fast model that would judge it is off its own "
             f"time simulation by E {F:.2f}, more than the repeat scatter")
     elif voltage:  # the coil's slope (`drive`)
-        def build(g):
-            return _usable_runs(assembly, envs, mrows, [{**r, "drive_gain": g} for r in rows], sdb, sdeg, settings,
-                                zeta_min)
+        build = partial(_runs_on_drive, assembly, envs, mrows, rows, sdb, sdeg, settings, zeta_min)
         gain, runs, drive = refine_slope(c0, theta0, gain, build, max_nfev=settings.max_nfev)
         rows = [{**r, "drive_gain": gain} for r in rows]
         say(f"{assembly}: the voltage drive's slope A' w_c / A_c refit with the baseline: "
@@ -197,7 +196,7 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
             f"baseline E {drive['baseline_E_read_out']:.2f} -> {drive['baseline_E_refined']:.2f}")
         clock.lap("drive")
     baseline_drive = (gain, runs, rows)  # the drive the baseline refit: kept where no model is named
-    lib = (assembly, space, m, theta0, settings, clock, say, scales)
+    lib = (assembly, space, m, theta0, settings, clock, say, scales, executor)  # the pool fits candidates side by side
     scored = _score_singles(*lib, runs)
     lead = min(scored, key=lambda s: s.score)
     if drive is not None and lead.name != "baseline":  # the baseline missed: the slope again with the single effect
@@ -240,7 +239,7 @@ def diagnose(assembly: str, envs: Mapping[str, pd.DataFrame], modal: pd.DataFram
         gain, runs, rows = baseline_drive
         drive["revalidated_with"] = "the baseline's slope"
     final, cf, rec, n_fits = _recalibrated(assembly, named if named is not None else base, space, m, runs,
-                                           joint_starts, settings, say, scales)
+                                           joint_starts, settings, say, scales, executor)
     clock.lap("recalibrate")
     say(f"{assembly}: decision {effect} ({confidence}); revalidating with the time simulation")
     v_after = validate_runs([model_at(cf, final.fit.theta, r) for r in rows], records, rows, **vkw)
@@ -300,19 +299,35 @@ def _usable_runs(assembly, envs, mrows, rows, sdb, sdeg, settings, zeta_min) -> 
     return runs
 
 
-def _score_singles(assembly, space, m, theta0, settings, clock, say, scales, runs, prev=None):
+def _score_singles(assembly, space, m, theta0, settings, clock, say, scales, ex, runs, prev=None):
     """The baseline and every single effect of the library, refit and scored on held-out folds (`score_candidates`).
 
     prev : the same candidates scored on the runs before the drive's slope was refit: each is then also refit
     from its fit there (the slope moved by a few per cent of itself; from the calibration's optimum alone a fit
     can land in a worse valley than the one it held: on a voltage campaign hiding a cubic, E 1.42 -> 1.77)."""
     cands = [candidate("baseline", space, m, scales)] + [candidate(n, space, m, scales) for n in settings.candidates]
-    scored = score_candidates(cands, runs, theta0, max_nfev=settings.max_nfev, log=say, starts=_warm(theta0, prev))
+    scored = score_candidates(cands, runs, theta0, max_nfev=settings.max_nfev, log=say, starts=_warm(theta0, prev),
+                              executor=ex)
     clock.lap("singles")
     return scored
 
 
-def _lead_on_its_drive(assembly, space, m, theta0, settings, clock, say, scales, scored, gain, build):
+def _runs_on_drive(assembly, envs, mrows, rows, sdb, sdeg, settings, zeta_min, gain) -> list:
+    """The assembly's usable runs (`_usable_runs`) with the voltage drive's modal constant `gain`."""
+    return _usable_runs(assembly, envs, mrows, [{**r, "drive_gain": gain} for r in rows], sdb, sdeg, settings,
+                        zeta_min)
+
+
+def _on_own_drive(c, s, gain, build, theta0, base, max_nfev):
+    """Scored single `s` of candidate `c` with the drive's slope refit with it: (scored, gain, runs, slope info)."""
+    g, runs, info = refine_slope(c, s.fit.theta, gain, build, max_nfev=max_nfev)
+    # a drive the effect leaves where it was: its score stands
+    own = s if g == gain else score_candidates([c], runs, theta0, baseline=base, max_nfev=max_nfev,
+                                               starts={s.name: [theta0, s.fit.theta]})[0]
+    return own, g, runs, info
+
+
+def _lead_on_its_drive(assembly, space, m, theta0, settings, clock, say, scales, ex, scored, gain, build):
     """A voltage drive: each single effect that fits the runs better than the baseline (E on all runs) or scores
     better, the drive's slope refit with it (`refine_slope`) and scored again on that drive; the best, as (scored,
     gain, runs, slope info). The stage asks only when a single scores better, so there is always one to refit.
@@ -324,13 +339,12 @@ def _lead_on_its_drive(assembly, space, m, theta0, settings, clock, say, scales,
     each on its own drive, the delay scored 1.21 against the neighbour's 1.42."""
     base = next(s for s in scored if s.name == "baseline")
     best = None
-    tried = (s for s in scored if s.name != "baseline" and (s.fit.E < base.fit.E or s.score < base.score))
-    for s in sorted(tried, key=lambda s: s.score):
-        c = candidate(s.name, space, m, scales)
-        g, runs, info = refine_slope(c, s.fit.theta, gain, build, max_nfev=settings.max_nfev)
-        # a drive the effect leaves where it was: its score stands
-        own = s if g == gain else score_candidates([c], runs, theta0, baseline=base, max_nfev=settings.max_nfev,
-                                                   starts={s.name: [theta0, s.fit.theta]})[0]
+    tried = sorted((s for s in scored if s.name != "baseline" and (s.fit.E < base.fit.E or s.score < base.score)),
+                   key=lambda s: s.score)
+    jobs = [(candidate(s.name, space, m, scales), s, gain, build, theta0, base, settings.max_nfev) for s in tried]
+    done = (ex.map(_on_own_drive, *zip(*jobs)) if ex is not None and len(jobs) > 1
+            else (_on_own_drive(*j) for j in jobs))  # each effect on its own drive, side by side on the pool
+    for s, (own, g, runs, info) in zip(tried, done):
         say(f"{assembly}: {s.name} on the drive refit with it ({complex(*info['relative_slope_refined']):.3f}): "
             f"held-out score {s.score:.2f} -> {own.score:.2f}")
         if best is None or own.score < best[0].score:
@@ -339,7 +353,8 @@ def _lead_on_its_drive(assembly, space, m, theta0, settings, clock, say, scales,
     return best
 
 
-def _add_pairs(assembly, space, m, theta0, settings, clock, say, scales, runs, scored, F, joint_starts, prev=None):
+def _add_pairs(assembly, space, m, theta0, settings, clock, say, scales, ex, runs, scored, F, joint_starts,
+               prev=None):
     """Pairs by forward selection when no single effect closes the gap (`rule.needs_pairs`; the bases refit from the
     calibration's other valleys first): the scored candidates with them, and the pairs tried. prev : as
     `_score_singles`'s (a pair fitted there is also refit from that fit)."""
@@ -349,7 +364,7 @@ def _add_pairs(assembly, space, m, theta0, settings, clock, say, scales, runs, s
         bases = pair_bases(scored)
         fits = {s.name: s.fit.theta for s in scored}
         refined = score_candidates([candidate(b, space, m, scales) for b in bases], runs, theta0, baseline=base, log=say,
-                                   max_nfev=2 * settings.max_nfev,
+                                   max_nfev=2 * settings.max_nfev, executor=ex,
                                    starts={b: [fits[b]] + [_with_joint(candidate(b, space, m, scales), fits[b], th)
                                                            for th in joint_starts] for b in bases})
         better = {r.name: r for r in refined if r.fit.E < next(s for s in scored if s.name == r.name).fit.E}
@@ -361,6 +376,7 @@ def _add_pairs(assembly, space, m, theta0, settings, clock, say, scales, runs, s
         pc = [candidate(n, space, m, scales) for n in names]
         before = {s.name: s.fit.theta for s in prev or ()}
         scored = scored + score_candidates(pc, runs, theta0, max_nfev=2 * settings.max_nfev, log=say, baseline=base,
+                                           executor=ex,
                                            starts={n: [fits[effects_of(n)[0]]] + ([before[n]] if n in before else [])
                                                    for n in names})
         pairs_tried = names
@@ -388,19 +404,20 @@ def _localise(c0, base, runs, mrows, m, sdb):
     return res, fp, ver, outside_library(fp)
 
 
-def _recalibrated(assembly, final, space, m, runs, joint_starts, settings, say, scales):
-    """The named (or baseline) model refit from the calibration's other valleys too, then recalibrated
-    (`recalibrate`: GA over the grown space, polish, emcee). Returns the scored candidate with the
-    recalibrated fit, the candidate, the recalibration and the number of seeding fits."""
+def _recalibrated(assembly, final, space, m, runs, joint_starts, settings, say, scales, ex=None):
+    """The named (or baseline) model refit from the calibration's other valleys too (on the pool `ex`, side by
+    side), then recalibrated (`recalibrate`: GA over the grown space, polish, emcee). Returns the scored candidate
+    with the recalibrated fit, the candidate, the recalibration and the number of seeding fits."""
     cf = candidate(final.name, space, m, scales)
-    fits = [final.fit]
-    for th in joint_starts:
-        start = _with_joint(cf, final.fit.theta, th)
-        alt = Objective(cf, runs).fit(start, starts=1, max_nfev=2 * settings.max_nfev, refresh=1)
+    starts = [_with_joint(cf, final.fit.theta, th) for th in joint_starts]
+    obj = Objective(cf, runs)
+    fit = partial(obj.fit, starts=1, max_nfev=2 * settings.max_nfev, refresh=1)
+    alts = list(ex.map(fit, starts) if ex is not None and len(starts) > 1 else map(fit, starts))
+    for start, alt in zip(starts, alts):
         say(f"{assembly}: {final.name} refit from Fs = {cf.grown.column(start, 'Fs'):.3g} lbf: E {alt.E:.2f}")
-        fits.append(alt)
+    fits = [final.fit, *alts]
     rec = recalibrate(cf, runs, fits, seed=settings.seed, generations=settings.ga_generations,
-                      steps=settings.posterior_steps, max_nfev=2 * settings.max_nfev)
+                      steps=settings.posterior_steps, max_nfev=2 * settings.max_nfev, executor=ex)
     say(f"{assembly}: {final.name} recalibrated: GA best E {rec.ga_best_E:.2f} ({rec.ga_generations} generations), "
         f"polished E {rec.fit.E:.2f}; emcee {rec.steps} steps, tau {rec.tau_max:.0f}")
     return type(final)(final.name, rec.fit, final.score, final.held_out, final.seconds), cf, rec, len(fits)

@@ -38,7 +38,7 @@ def _jenkins(s):
     return (th - 0.5 * np.sin(2.0 * th)) / PI
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _J(chi, smax, nodes, weights):
     """J = int_0^smax (1 - g(s)) s^chi ds (as `amplitude._J`: split at s = 1/2)."""
     a = chi + 1.0
@@ -74,7 +74,7 @@ def _quadratic_damper(q, w, a, im, dim, C, C1):
     return im + t, dim + t, C + 16.0 * a * w * q / (3.0 * PI), C1 + 16.0 * a * q / (3.0 * PI)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _backbone_first_harmonic(q, KT, R, chi, phimax, nodes, weights):
     """First-harmonic stiffness k_b (lbf/in) of the Iwan joint's virgin backbone F_b taken as an elastic
     spring, at amplitude q (in), and its slope dk_b / dlog q.
@@ -164,7 +164,7 @@ def _residual(s, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, codes,
     return r, dr, re, im
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _root(s0, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes, weights, tol):
     """A stable root of r near s0 (bracketed Newton), and whether the walk left a vanished branch.
 
@@ -253,11 +253,11 @@ def _solve(w, mu_re, mu_im, logB, s_start, order, kp, c, KT, R, chi, phimax, S, 
             kim_out[p, n] = im
 
 
-solve = njit(cache=True)(_solve)
+solve = njit(cache=True, nogil=True)(_solve)
 solve_parallel = njit(cache=True, parallel=True)(_solve)  # the same kernel with the sets spread over threads
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def rigid_output(kre, kim, mu, mA, w, A, gain, tau, Z_out, T_out):
     """Rigid base, in one pass: Z = -m A / (K_z - m omega^2), T = gain (1 - omega^2 Z / A) e^{-i omega tau}."""
     P, N = kre.shape
@@ -271,7 +271,7 @@ def rigid_output(kre, kim, mu, mA, w, A, gain, tau, Z_out, T_out):
             T_out[p, n] = t
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def stiffness_slopes(q, w, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes, weights, out):
     """K_z and its slopes at amplitudes q (P, N), omega w (N,); parameter arrays (P,), coefs (P, n_e, 2).
 
@@ -307,7 +307,7 @@ def _flow(z, w, al, p0, g0, m1, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, 
     return zdot, kz * z + C * zdot
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def slow_flow(z0, h, w, al, p0, g0, m1, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes, weights, force_out):
     """RK4 of the slow flow (`_flow`) from Z(0) = z0 for one parameter set.
 
