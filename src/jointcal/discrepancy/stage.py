@@ -342,8 +342,13 @@ def _lead_on_its_drive(assembly, space, m, theta0, settings, clock, say, scales,
     tried = sorted((s for s in scored if s.name != "baseline" and (s.fit.E < base.fit.E or s.score < base.score)),
                    key=lambda s: s.score)
     jobs = [(candidate(s.name, space, m, scales), s, gain, build, theta0, base, settings.max_nfev) for s in tried]
-    done = (ex.map(_on_own_drive, *zip(*jobs)) if ex is not None and len(jobs) > 1
-            else (_on_own_drive(*j) for j in jobs))  # each effect on its own drive, side by side on the pool
+    if ex is not None and len(jobs) > 1:  # each effect on its own drive, side by side on the pool (most parameters,
+        # the longest fits, first)
+        futures = {i: ex.submit(_on_own_drive, *jobs[i]) for i in sorted(range(len(jobs)),
+                                                                          key=lambda i: -len(jobs[i][0].names))}
+        done = (futures[i].result() for i in range(len(jobs)))
+    else:
+        done = (_on_own_drive(*j) for j in jobs)
     for s, (own, g, runs, info) in zip(tried, done):
         say(f"{assembly}: {s.name} on the drive refit with it ({complex(*info['relative_slope_refined']):.3f}): "
             f"held-out score {s.score:.2f} -> {own.score:.2f}")
