@@ -222,35 +222,37 @@ def _root(s0, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, codes, co
     return s, jumped, re, im
 
 
-def _solve(w, mu_re, mu_im, logB, s_start, order, kp, c, KT, R, chi, phimax, S, J1, codes, coefs,
-          nodes, weights, tol, s_out, jump_out, kre_out, kim_out):
-    """Amplitudes s = log q (P, N) by continuation along `order` for every parameter set.
+def _solve(w, mu_re, mu_im, logB, s_start, order, bounds, kp, c, KT, R, chi, phimax, S, J1, codes, coefs,
+           nodes, weights, tol, s_out, jump_out, kre_out, kim_out):
+    """Amplitudes s = log q (P, N) by continuation along each segment's `order` for every parameter set.
 
-    w (N,) rad/s; mu_re, mu_im, logB (P, N); s_start (P,) a guess for the first
-    frequency (below every branch for an up sweep's low end, see `envelope`); parameter
-    arrays (P,). Writes s_out, jump_out and the joint DOF's dynamic stiffness at the
-    solution (kre_out + i kim_out, lbf/in), all (P, N).
+    w (N,) rad/s; mu_re, mu_im, logB (P, N); segment g is continued along order[bounds[g]:bounds[g + 1]]
+    (indices into the N frequencies: several runs laid end to end, each continued on its own, as a run alone
+    would be) from s_start[g] (P,), a guess for its first frequency (below every branch for an up sweep's low
+    end, see `envelope`); parameter arrays (P,). Writes s_out, jump_out and the joint DOF's dynamic stiffness
+    at the solution (kre_out + i kim_out, lbf/in), all (P, N).
     """
     P = mu_re.shape[0]
-    N = w.shape[0]
     for p in prange(P):  # a plain range unless compiled parallel
-        s = s_start[p]
-        s_prev = s
-        for jj in range(N):
-            n = order[jj]
-            guess = s
-            if jj >= 2:  # continue the branch by linear extrapolation in frequency
-                n1 = order[jj - 1]
-                n2 = order[jj - 2]
-                if w[n1] != w[n2]:  # at most a factor e: frames close in frequency must not throw it far
-                    guess = s + max(-1.0, min(1.0, (s - s_prev) * (w[n] - w[n1]) / (w[n1] - w[n2])))
+        for g in range(bounds.shape[0] - 1):
+            first = bounds[g]
+            s = s_start[g, p]
             s_prev = s
-            s, jumped, re, im = _root(guess, w[n], mu_re[p, n], mu_im[p, n], logB[p, n], kp[p], c[p], KT[p], R[p],
-                                      chi[p], phimax[p], S[p], J1[p], codes, coefs[p], nodes, weights, tol)
-            s_out[p, n] = s
-            jump_out[p, n] = jumped and jj > 0
-            kre_out[p, n] = re
-            kim_out[p, n] = im
+            for jj in range(bounds[g + 1] - first):
+                n = order[first + jj]
+                guess = s
+                if jj >= 2:  # continue the branch by linear extrapolation in frequency
+                    n1 = order[first + jj - 1]
+                    n2 = order[first + jj - 2]
+                    if w[n1] != w[n2]:  # at most a factor e: frames close in frequency must not throw it far
+                        guess = s + max(-1.0, min(1.0, (s - s_prev) * (w[n] - w[n1]) / (w[n1] - w[n2])))
+                s_prev = s
+                s, jumped, re, im = _root(guess, w[n], mu_re[p, n], mu_im[p, n], logB[p, n], kp[p], c[p], KT[p],
+                                          R[p], chi[p], phimax[p], S[p], J1[p], codes, coefs[p], nodes, weights, tol)
+                s_out[p, n] = s
+                jump_out[p, n] = jumped and jj > 0
+                kre_out[p, n] = re
+                kim_out[p, n] = im
 
 
 solve = njit(cache=True, nogil=True)(_solve)

@@ -31,6 +31,7 @@ sweep) and the quadrature `GAUSS_NODES`, `GAUSS_WEIGHTS`.
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, fields as dataclass_fields
 from typing import Literal
 
@@ -126,33 +127,41 @@ def joint_terms(model: MinistackModel, shape) -> tuple[NDArray, ...]:
 
 
 def sweep_amplitudes(f: NDArray, A: NDArray, direction: str, shape, joint, m: NDArray, mu: NDArray,
-                     gamma: NDArray | None) -> tuple[NDArray, ...]:
+                     gamma: NDArray | None, segments: Sequence[tuple[int, int, str]] | None = None
+                     ) -> tuple[NDArray, ...]:
     """The kernel's continuation along the sweep: s = log q, jump flags and K_z = kre + i kim, each (P, N).
 
     joint : `joint_terms`; m (P,); mu (P, N) and gamma (P, N) or None (rigid base) from
-    `_structure_terms`; A (N,) base amplitude, in/s^2.
+    `_structure_terms`; A (N,) base amplitude, in/s^2. segments : (start, stop, direction) of several runs laid
+    end to end along f, each continued on its own as a run alone would be, in one call of the kernel (direction
+    is then unused); None: f is one run.
     """
     P = shape[0]
     w = 2 * np.pi * f
     k, c, KT, R, chi, phimax, S, J1, codes, coefs = joint
     rigid = gamma is None
     logB = np.log(m[:, None] * A) + (0.0 if rigid else np.log(np.abs(gamma)))
-    order = np.argsort(f, kind="stable")
-    if direction == "down":
-        order = order[::-1]
-    n0 = order[0]
-    stuck = k + KT + 1j * w[n0] * c
-    g0 = 1.0 if rigid else np.abs(gamma[:, n0])
-    s0 = np.log(g0 * m * A[n0] / np.abs(stuck - mu[:, n0]))
+    segments = [(0, f.size, direction)] if segments is None else segments
+    orders, s_start = [], np.empty((len(segments), P))
+    for g, (a, b, way) in enumerate(segments):  # each segment's sweep order and start, as a run alone
+        order = np.argsort(f[a:b], kind="stable")
+        if way == "down":
+            order = order[::-1]
+        n0 = order[0] + a
+        stuck = k + KT + 1j * w[n0] * c
+        g0 = 1.0 if rigid else np.abs(gamma[:, n0])
+        s_start[g] = np.log(g0 * m * A[n0] / np.abs(stuck - mu[:, n0]))
+        orders.append(order + a)
+    bounds = np.array([0, *np.cumsum([b - a for a, b, _ in segments])], dtype=np.int64)
     s = np.empty((P, f.size))
     jump = np.zeros((P, f.size), dtype=np.bool_)
     kre, kim = np.empty((P, f.size)), np.empty((P, f.size))
     solver = _k.solve_parallel if P >= 64 else _k.solve  # threads pay off only for large batches
     mu_re = np.ascontiguousarray(mu.real)
     mu_im = np.zeros_like(mu_re) if rigid else np.ascontiguousarray(mu.imag)
-    solver(w, mu_re, mu_im, np.ascontiguousarray(np.broadcast_to(logB, (P, f.size))), s0,
-           order.astype(np.int64), k, c, KT, R, chi, phimax, S, J1, codes, coefs, GAUSS_NODES, GAUSS_WEIGHTS, TOL,
-           s, jump, kre, kim)
+    solver(w, mu_re, mu_im, np.ascontiguousarray(np.broadcast_to(logB, (P, f.size))), s_start,
+           np.concatenate(orders).astype(np.int64), bounds, k, c, KT, R, chi, phimax, S, J1, codes, coefs,
+           GAUSS_NODES, GAUSS_WEIGHTS, TOL, s, jump, kre, kim)
     return s, jump, kre, kim
 
 

@@ -225,20 +225,6 @@ def _linearised(D: NDArray, Ks: NDArray, Z0: NDArray):
     return solve
 
 
-def _segment_amplitudes(f: NDArray, A: NDArray, segments: Sequence[tuple[int, int, str]], shape, joint, m: NDArray,
-                        mu: NDArray, gamma: NDArray | None) -> tuple[NDArray, ...]:
-    """`envelope._amplitudes` of runs laid end to end along f: each segment (start, stop, direction)
-    is continued on its own, as a run alone would be."""
-    P = shape[0]
-    out = (np.empty((P, f.size)), np.zeros((P, f.size), dtype=np.bool_), np.empty((P, f.size)), np.empty((P, f.size)))
-    for a, b, direction in segments:
-        part = _amplitudes(f[a:b], A[a:b], direction, (P, b - a), joint, m, mu[:, a:b],
-                           None if gamma is None else gamma[:, a:b])
-        for whole, piece in zip(out, part):
-            whole[:, a:b] = piece
-    return out
-
-
 def _quasi_steady(model: MinistackModel, f: NDArray, base_g: NDArray, rate: NDArray, dlog: NDArray,
                   direction: str, joint: tuple | None = None,
                   segments: Sequence[tuple[int, int, str]] | None = None) -> tuple[NDArray, NDArray, NDArray]:
@@ -246,7 +232,7 @@ def _quasi_steady(model: MinistackModel, f: NDArray, base_g: NDArray, rate: NDAr
 
     joint : the model's `_joint_terms` when already at hand (they do not depend on the frequencies).
     segments : (start, stop, direction) of several runs laid end to end along f, each continued on its
-    own (`_segment_amplitudes`; direction is then unused); None: f is one run.
+    own (`envelope.sweep_amplitudes`; direction is then unused); None: f is one run.
     Every other step is elementwise in the frames, so a run's values do not depend on its neighbours."""
     shape, _ = _batch_shape(model, f.shape)
     P, N = shape
@@ -257,8 +243,7 @@ def _quasi_steady(model: MinistackModel, f: NDArray, base_g: NDArray, rate: NDAr
     mu, mu1, mu2, F, F1, F2 = _derivs(model, w, shape)
     gamma = None if model.fixture is None and not _looped(model) else -F / m[:, None]
     mu_joint = mu if gamma is not None else mu.real
-    s, _, kre, kim = (_amplitudes(f, A, direction, shape, joint, m, mu_joint, gamma) if segments is None
-                      else _segment_amplitudes(f, A, segments, shape, joint, m, mu_joint, gamma))
+    s, _, kre, kim = _amplitudes(f, A, direction, shape, joint, m, mu_joint, gamma, segments)
     q = np.exp(s)
     Kz = kre + 1j * kim
     D = Kz - mu
