@@ -24,10 +24,13 @@ valleys of equal E. Its reported interval is that single value.
 """
 from __future__ import annotations
 
+import pickle
+import uuid
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 import pandas as pd
 
 from ..calibrate.fit import pick_polished, search
@@ -71,17 +74,31 @@ class Recalibration:
         return [float(self.quantiles.at[name, "q05"]), float(self.quantiles.at[name, "q95"])]
 
 
+_SENT: dict = {}  # in a pool's worker: the residual function it was sent last, by its key
+
+
+def _residuals_sent(key: str, blob: bytes, theta: NDArray) -> NDArray:
+    """A pool worker's half of a batch: the residual function pickled in `blob`, unpickled once per `key`."""
+    if key not in _SENT:
+        _SENT.clear()
+        _SENT[key] = pickle.loads(blob)
+    return _SENT[key](theta)
+
+
 def _in_halves(residuals, executor, min_rows: int = 8):
     """`residuals` of a batch of parameter sets (P, n) -> (P, m) in two halves, the second on the executor (when
-    given) while this process computes the first. Always in halves, pool or not: numpy's vectorised exp and log
-    round an element by where it sits in its array (1e-14 apart), so a set's residuals are the same in a half
-    batch only as in the same half batch. Under 2 x min_rows sets: one call."""
+    given; the function pickled once, unpickled once per worker) while this process computes the first. Always
+    in halves, pool or not: numpy's vectorised exp and log round an element by where it sits in its array (1e-14
+    apart), so a set's residuals are the same in a half batch only as in the same half batch. Under 2 x min_rows
+    sets: one call."""
+    key, blob = (uuid.uuid4().hex, pickle.dumps(residuals)) if executor is not None else (None, None)
+
     def halves(theta):
         th = np.asarray(theta, dtype=float)
         if th.ndim < 2 or th.shape[0] < 2 * min_rows:
             return residuals(th)
         h = th.shape[0] // 2
-        other = executor.submit(residuals, th[h:]) if executor is not None else None
+        other = executor.submit(_residuals_sent, key, blob, th[h:]) if executor is not None else None
         first = residuals(th[:h])
         return np.concatenate([first, residuals(th[h:]) if other is None else other.result()])
     return halves
