@@ -374,6 +374,26 @@ campaign: unchanged (unexplained, E 9.36 -> 8.15 and 78.2 -> 11.8). Stage times:
 Alone on the machine afterwards (load 1.5-2, its own two workers): the neighbour's seed 1 89 s (singles 27, the
 recalibration 22, the time-domain revalidation 33), the pair's seed 3 193 s (recalibration 66, singles 45, pairs 34,
 revalidation 28, drive 19): over 2 minutes.
+
+2026-11-27, later (d1a2d4b): the stage on its pool. The candidates of each scoring pass are fitted side by side on
+the stage's process pool (the longest first), as are the singles' drive refits and the valley refits, and each batch
+of the recalibration's GA and chain is split in halves, the second on the pool (always in halves, pool or not, so the
+numbers do not depend on it); the envelope kernel releases the GIL and continues all runs in one call. Every
+diagnosis below is the same as before, to the last digit but the timings. The same kept campaigns, rediagnosed one
+at a time with the workflow's one BLAS thread per process (the earlier times above ran the harness with two BLAS
+threads in each worker, which the workflow's stage jobs never do):
+
+    campaign (voltage unless said)   before   now     steps now (s)
+    pair (elastic + cubic) seed 3    193 s    122, 129, 136, 123 s   recalibration 54-57 (the chain 47), singles 22-30,
+                                                                     pairs 22-27, drive 12-14, revalidation 7-8
+    neighbour_mode seed 1             89 s    53 s     recalibration 27, singles 12, revalidation 8
+    neighbour_mode (force) seed 1      -      50 s     recalibration 24, pairs 9, singles 8, revalidation 9
+    none seed 1                        -      31 s     recalibration 21, singles 5
+    contact_spring seed 1          122 s (load)  59 s  pairs 20, singles 14, recalibration 13
+
+Every campaign but the voltage pair is well under 2 minutes; the pair stays at 2 minutes (122-136 s over four
+runs). Its floor is the chain: 800 steps x 32 walkers of the fast model, about 3 ms of CPU per parameter set, in
+two processes on two cores. A shorter chain would change the intervals; it was not shortened.
 """
 import argparse
 import json

@@ -40,7 +40,7 @@ from .data import RunEnvelope
 from ..io import level_unit
 from .fit import HELD, Candidate, Fit, Objective
 
-__all__ = ["PENALTY_PER_PARAM", "Scored", "score_candidates", "predictive_E"]
+__all__ = ["PENALTY_PER_PARAM", "Scored", "score_candidates", "predictive_E", "side_by_side"]
 
 PENALTY_PER_PARAM = 0.02
 
@@ -145,6 +145,15 @@ def _rms(values) -> float:
     return float(np.sqrt(np.mean(np.square(list(values))))) if len(values) else float("nan")
 
 
+def side_by_side(executor, fn, jobs: Sequence[tuple], sizes: Sequence[int]):
+    """``fn(*job)`` of each job, read back in order: on the executor, the jobs of the largest `sizes` (the
+    candidates with the most parameters, the longest fits) submitted first; here, one after the other."""
+    if executor is None or len(jobs) < 2:
+        return (fn(*j) for j in jobs)
+    futures = {i: executor.submit(fn, *jobs[i]) for i in sorted(range(len(jobs)), key=lambda i: -sizes[i])}
+    return (futures[i].result() for i in range(len(jobs)))
+
+
 def _fit_and_hold_out(c: Candidate, runs: Sequence[RunEnvelope], starts: Sequence[np.ndarray], max_nfev: int,
                       folds: dict[str, list[int]], predictive: bool, objective) -> tuple[Fit, dict, float]:
     """One candidate's fit on all runs (the lowest E from `starts`) and its held-out E per fold, and the seconds
@@ -183,12 +192,7 @@ def score_candidates(cands: Sequence[Candidate], runs: Sequence[RunEnvelope], th
     base_score = baseline.score if baseline is not None else None
     jobs = [(c, runs, (starts or {}).get(c.name, [theta_base]), max_nfev, folds, predictive, objective)
             for c in cands]
-    if executor is not None and len(jobs) > 1:  # the candidates with the most parameters (the longest fits) first
-        futures = {i: executor.submit(_fit_and_hold_out, *jobs[i])
-                   for i in sorted(range(len(jobs)), key=lambda i: -len(cands[i].names))}
-        done = (futures[i].result() for i in range(len(jobs)))
-    else:
-        done = (_fit_and_hold_out(*j) for j in jobs)
+    done = side_by_side(executor, _fit_and_hold_out, jobs, [len(c.names) for c in cands])
     for c, (full, per, seconds) in zip(cands, done):
         if c.name == "baseline":
             base_per = per

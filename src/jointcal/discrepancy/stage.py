@@ -28,6 +28,10 @@
    (E above `rule.NONE_E` before and after) becomes 'unexplained'; a name the time
    simulation does not confirm (E not lower after) keeps confidence low.
 
+The stage's process pool (`executor`, the rule's threads) takes the time simulations, the candidates of each
+scoring pass (`select.score_candidates`), the singles' drive refits, the valley refits and half of each batch of the
+recalibration's GA and chain (`recalibrate`); every number is the one the stage computes without it.
+
 A campaign of ring-downs and dwells alone (no sweep) takes the same steps on its backbone points
 (`decay_stage.diagnose_decays`: each candidate's free-decay backbone, held-out runs, the same rule,
 recalibration and time-domain revalidation of the decays).
@@ -62,7 +66,7 @@ from .floor import fast_floor
 from .recalibrate import recalibrate
 from .rule import CLAUSES, confirm, decide, needs_pairs, pair_bases, pair_names
 from .settings import DiscrepancySettings
-from .select import score_candidates
+from .select import score_candidates, side_by_side
 from .words import diagnosis_markdown
 
 __all__ = ["DiscrepancySettings", "diagnose", "diagnosis_markdown", "valley_starts", "run_discrepancy"]
@@ -342,13 +346,7 @@ def _lead_on_its_drive(assembly, space, m, theta0, settings, clock, say, scales,
     tried = sorted((s for s in scored if s.name != "baseline" and (s.fit.E < base.fit.E or s.score < base.score)),
                    key=lambda s: s.score)
     jobs = [(candidate(s.name, space, m, scales), s, gain, build, theta0, base, settings.max_nfev) for s in tried]
-    if ex is not None and len(jobs) > 1:  # each effect on its own drive, side by side on the pool (most parameters,
-        # the longest fits, first)
-        futures = {i: ex.submit(_on_own_drive, *jobs[i]) for i in sorted(range(len(jobs)),
-                                                                          key=lambda i: -len(jobs[i][0].names))}
-        done = (futures[i].result() for i in range(len(jobs)))
-    else:
-        done = (_on_own_drive(*j) for j in jobs)
+    done = side_by_side(ex, _on_own_drive, jobs, [len(j[0].names) for j in jobs])  # each on its own drive
     for s, (own, g, runs, info) in zip(tried, done):
         say(f"{assembly}: {s.name} on the drive refit with it ({complex(*info['relative_slope_refined']):.3f}): "
             f"held-out score {s.score:.2f} -> {own.score:.2f}")
