@@ -149,7 +149,8 @@ def recalibrate(c: Candidate, runs: Sequence[RunEnvelope], starts: Sequence[Fit]
     ga = search(lp.misfit_unit, c.grown, options, free=lp.free, at=lp.at, init=init)
     pol = obj.fit(lp.physical(ga.best[None])[0], starts=1, max_nfev=max_nfev, refresh=1)
     best = _chosen([pol, *starts], c, runs, obj.residuals(pol.theta).size)
-    lp = _posterior(obj.at(best.theta), best, max(best.E**2, 1.0), executor)  # the chain holds beta at the chosen fit's value
+    # the chain holds beta at the chosen fit's value
+    lp = _posterior(obj.at(best.theta), best, max(best.E**2, 1.0), executor)
     # the Gauss-Newton width, within [0.003, 0.01] of the unit cube: a flat direction must not
     # start as a point, or the ensemble explores it too slowly
     sd = np.sqrt(np.clip(np.diag(best.cov_unit)[lp.free], 9e-6, 1e-4))

@@ -415,7 +415,7 @@ def _recalibrated(assembly, final, space, m, runs, joint_starts, settings, say, 
     starts = [_with_joint(cf, final.fit.theta, th) for th in joint_starts]
     obj = Objective(cf, runs)
     fit = partial(obj.fit, starts=1, max_nfev=2 * settings.max_nfev, refresh=1)
-    alts = list(ex.map(fit, starts) if ex is not None and len(starts) > 1 else map(fit, starts))
+    alts = list(side_by_side(ex, fit, [(s,) for s in starts], [0] * len(starts)))
     for start, alt in zip(starts, alts):
         say(f"{assembly}: {final.name} refit from Fs = {cf.grown.column(start, 'Fs'):.3g} lbf: E {alt.E:.2f}")
     fits = [final.fit, *alts]
