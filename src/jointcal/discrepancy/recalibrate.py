@@ -88,9 +88,9 @@ def _residuals_sent(key: str, blob: bytes, theta: NDArray) -> NDArray:
 def _in_halves(residuals, executor, min_rows: int = 8):
     """`residuals` of a batch of parameter sets (P, n) -> (P, m) in two halves, the second on the executor (when
     given; the function pickled once, unpickled once per worker) while this process computes the first. Always
-    in halves, pool or not: numpy's vectorised exp and log round an element by where it sits in its array (1e-14
-    apart), so a set's residuals are the same in a half batch only as in the same half batch. Under 2 x min_rows
-    sets: one call."""
+    in halves, pool or not: a set's residuals can differ at 1e-14 with the size of the batch they are computed in
+    (vectorised kernels choose their paths by array size; a GA's best E moved in its last digit), so the same
+    halves give the same numbers with or without the pool. Under 2 x min_rows sets: one call."""
     key, blob = (uuid.uuid4().hex, pickle.dumps(residuals)) if executor is not None else (None, None)
 
     def halves(theta):
