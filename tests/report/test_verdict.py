@@ -101,6 +101,19 @@ def _identified_k0():
     return pd.DataFrame(rows)
 
 
+@pytest.mark.parametrize("p, shown", [(0.13, "p = 0.13"), (0.046, "p = 0.046"), (2e-54, "p = 2e-54")])
+def test_the_chi_square_p_is_printed_as_it_stands_against_the_rejection_level(p, shown):
+    """Read against P_REJECT (0.05), p keeps two significant digits: the real UNESP beam's 0.13 printed as 0.1, and
+    0.046 (rejected) would have printed as 0.05."""
+    from jointcal.posterior.stage import P_REJECT
+
+    (_, a1), *_ = verdict_items(best={"model_kind": "modal", "excitation": "voltage"}, identified=_identified_k0(),
+                                validation=None, fit={"fit_chi2": 9.767, "fit_dof": 6.0, "fit_p": p},
+                                diagnosis=None, next_test=None, corrected={})
+    assert shown in a1
+    assert ("are rejected by" in a1) == (p < P_REJECT)
+
+
 @pytest.mark.parametrize("newer", [False, True])
 def test_verdict_answers_in_order_and_reads_either_form_of_the_diagnosis(newer):
     diag = {"effect": "fixture_flexibility", "confidence": "high", "metric_before": 17.13, "metric_after": 0.41,

@@ -20,7 +20,7 @@ from ..io import write_bytes_atomic
 from ..posterior import NAMES, PosteriorSettings, find_modes
 from ..posterior.identified import identified_at, settled
 from ..posterior.noise import scale_words
-from .summary import bound_hits, chain_status, ga_best_point, landing_html, summary_html
+from .summary import bound_hits, chain_status, ga_best_point, landing_html, p_value, summary_html
 from .table_3_2 import table_3_2_html
 from .verdict import corrected_holds, identified_html, verdict_html, verdict_items
 
@@ -44,7 +44,7 @@ def _details(arrays: dict, modes: pd.DataFrame | None, identified: pd.DataFrame)
         lines.append(f"Fit of the polished optimum: rms relative residuals {ratio[0]:.1f} (frequency) and "
                      f"{ratio[1]:.1f} (damping) x {scale_words(_sources(arrays))}; chi-square "
                      f"{float(arrays['fit_chi2']):.0f} for {int(arrays['fit_dof'])} degrees of freedom "
-                     f"(p = {float(arrays['fit_p']):.1g}).")
+                     f"(p = {p_value(float(arrays['fit_p']))}).")
     if modes is not None and len(modes) and modes["mode"].max() > 0:
         fixed = [p for p in identified.loc[identified["identified"] & (identified["kind"] == "parameter"), "quantity"]]
         parts = []

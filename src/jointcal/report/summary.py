@@ -42,6 +42,12 @@ def fmt(v: float) -> str:
     return f"{float(mant):.3g}e{int(exp)}"
 
 
+def p_value(p: float) -> str:
+    """A chi-square test's p: two significant digits from 1e-3 up, where it is read against the rejection level
+    (`jointcal.posterior.stage.P_REJECT`; 0.046 must not print as 0.05, nor 0.13 as 0.1), one below."""
+    return f"{p:.2g}" if p >= 1e-3 else f"{p:.1g}"
+
+
 def ga_best_point(history: pd.DataFrame) -> dict[str, float]:
     """The GA's best evaluated individual (``ga_history.csv``: objective and the six parameters)."""
     row = history.loc[history["objective"].idxmin()]

@@ -34,7 +34,7 @@ from ..effects import EFFECTS
 from ..posterior.noise import scale_words as noise_words
 from ..posterior.stage import P_REJECT
 from ..validate.error import closeness, scale_source, scale_words
-from .summary import fmt as _g
+from .summary import fmt as _g, p_value
 
 __all__ = ["HOLDS_E", "first_answer", "named_effects", "corrected_holds", "verdict_items", "identified_html",
            "verdict_html"]
@@ -102,7 +102,7 @@ def _item1(best: Mapping, validation: Mapping | None, fit: Mapping | None) -> st
         chi_ok = p >= P_REJECT
         chi_text = (f"{'agree with' if chi_ok else 'are rejected by'} "
                     f"{'the repeats' if sources == ('repeats', 'repeats') else noise_words(sources)}: chi-square "
-                    f"{_g(float(fit['fit_chi2']))} for {int(fit['fit_dof'])} degrees of freedom, p = {p:.1g}"
+                    f"{_g(float(fit['fit_chi2']))} for {int(fit['fit_dof'])} degrees of freedom, p = {p_value(p)}"
                     f"{'' if chi_ok else ' (the model, not noise, sets the misfit)'}")
     if e_ok is False or e_ok is None and chi_ok is False or e_ok and chi_ok is not False:
         # the first test shown carries the answer (E, else the chi-square), the other agrees or adds to it
