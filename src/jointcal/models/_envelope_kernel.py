@@ -180,31 +180,34 @@ def _root(s0, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, codes, co
     step = 0.02
     if d0 > 0.0:
         step = min(max(abs(r0 / d0), 1e-6), 0.25)
-    a = s0
-    ra = r0
+    a, ra, da, rea, ima = s0, r0, d0, re, im  # each end keeps its residual, slope and K_z: none is evaluated twice
     rprev = r0
     jumped = False
-    b = a
-    rb = ra
+    b, rb, db, reb, imb = a, ra, da, rea, ima
     for _ in range(200):
         b = a + direction * step
-        rb, db, re, im = _residual(b, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes, weights)
+        rb, db, reb, imb = _residual(b, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes,
+                                     weights)
         if abs(rb) < tol and not jumped:  # the Newton step from a continued guess has converged
-            return b, False, re, im
+            return b, False, reb, imb
         if rb * ra <= 0.0:
             break
         if abs(rb) > abs(rprev):  # moving away from zero: r turned at an extremum, the branch is gone
             jumped = True
         rprev = rb
-        a = b
-        ra = rb
+        a, ra, da, rea, ima = b, rb, db, reb, imb
         step = min(step * 1.6, 0.5)
-    # bracket [a, b] (unordered): safeguarded Newton
+    # bracket [a, b] (unordered): safeguarded Newton from the end nearer the root
     lo, hi = (a, b) if a < b else (b, a)
     rlo = ra if a < b else rb
-    s = b if abs(rb) < abs(ra) else a
-    for _ in range(100):
-        r, dr, re, im = _residual(s, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes, weights)
+    if abs(rb) < abs(ra):
+        s, r, dr, re, im = b, rb, db, reb, imb
+    else:
+        s, r, dr, re, im = a, ra, da, rea, ima
+    for it in range(100):
+        if it > 0:
+            r, dr, re, im = _residual(s, w, mu_re, mu_im, logB, kp, c, KT, R, chi, phimax, S, J1, codes, coefs, nodes,
+                                      weights)
         if abs(r) < tol:
             return s, jumped, re, im
         if (r < 0.0) == (rlo < 0.0):
