@@ -191,3 +191,35 @@ def test_irregular_frames_stay_finite_and_below_the_dashpot_bound():
         c = 2 * zv * np.sqrt((k + 1.02e6) * M)
         assert np.all(np.isfinite(q))
         assert np.all(q <= M * base * G / (c * 2 * np.pi * f))
+
+
+@pytest.mark.parametrize("chi", [-0.95, -0.5, 0.0])
+@pytest.mark.parametrize("ratio", [0.05, 0.6, 1.0, 1.7, 6.0])  # q / phi_max: microslip, the onset, macroslip
+def test_the_kernels_backbone_first_harmonic_is_the_cycle_integral_of_the_backbone(chi, ratio):
+    """k_b = 4/(pi q) int_0^{pi/2} F_b(q cos t) cos t dt of the virgin backbone (eq. 3.2, `iwan.backbone`) by
+    adaptive quadrature, and its slope d k_b / d log q by finite differences of that integral."""
+    from scipy.integrate import quad
+
+    from jointcal.models import IwanParams, backbone
+    from jointcal.models._envelope_kernel import _backbone_first_harmonic
+    from jointcal.models.envelope import GAUSS_NODES, GAUSS_WEIGHTS
+    from jointcal.models.iwan import derived
+
+    p = IwanParams(4.0, 204.0, chi, 0.1)
+    phimax, R, _ = (float(np.asarray(v)) for v in derived(p.Fs, p.KT, p.chi, p.beta))
+
+    def kb(q):
+        lim = [np.arccos(min(phimax / q, 1.0))] if q > phimax else None
+        I = quad(lambda t: float(backbone(q * np.cos(t), p)) * np.cos(t), 0.0, np.pi / 2, points=lim,
+                 epsabs=0.0, epsrel=1e-13, limit=200)[0]
+        return 4.0 * I / (np.pi * q)
+
+    q = ratio * phimax
+    k, dk = _backbone_first_harmonic(q, p.KT, R, chi, phimax, GAUSS_NODES, GAUSS_WEIGHTS)
+    h = 1e-5
+    assert k == pytest.approx(kb(q), rel=1e-7)
+    if ratio == 1.0:  # the backbone's slope jumps at phi_max (beta > 0): the kernel's is the microslip side's
+        slope = (3 * kb(q) - 4 * kb(q * np.exp(-h)) + kb(q * np.exp(-2 * h))) / (2 * h)
+    else:
+        slope = (kb(q * np.exp(h)) - kb(q * np.exp(-h))) / (2 * h)
+    assert dk == pytest.approx(slope, rel=1e-5, abs=1e-6 * p.KT)

@@ -19,6 +19,8 @@ equation of the joint DOF in a frame rotating with the drive.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit, prange
 
@@ -82,17 +84,22 @@ def _backbone_first_harmonic(q, KT, R, chi, phimax, nodes, weights):
     k_b = (4 / (pi q)) I, I = int_0^{pi/2} F_b(q cos t) cos t dt with F_b = KT z - R' z^n (n = chi + 2,
     R' = R / ((chi + 1)(chi + 2))) below phi_max and Fs beyond (`iwan.backbone`). With t_c = arccos(phi_max / q)
     (0 in microslip), I = Fs sin t_c + KT q (pi/4 - t_c/2 - sin(2 t_c)/4) - R' q^n M, M = int_{t_c}^{pi/2}
-    cos^{n+1} t dt (Gauss-Legendre on the nodes). F_b is continuous at t_c, so the t_c-terms of dI/dq
+    cos^{n+1} t dt: in microslip Wallis' integral sqrt(pi)/2 Gamma((n + 2)/2) / Gamma((n + 3)/2), in macroslip
+    Gauss-Legendre on the nodes. F_b is continuous at t_c, so the t_c-terms of dI/dq
     cancel: dI/dq = KT (pi/4 - t_c/2 - sin(2 t_c)/4) - n R' q^{n-1} M, and dk_b/dlog q = (4/pi)(dI/dq - I/q).
     """
     n = chi + 2.0
     Rp = R / ((chi + 1.0) * (chi + 2.0))
-    tc = 0.0 if q <= phimax else np.arccos(phimax / q)
-    M = 0.0
-    for i in range(nodes.shape[0]):
-        t = tc + (0.5 * PI - tc) * nodes[i]
-        M += weights[i] * np.cos(t) ** (n + 1.0)
-    M *= 0.5 * PI - tc
+    if q <= phimax:  # microslip: Wallis' integral
+        tc = 0.0
+        M = 0.5 * np.sqrt(PI) * np.exp(math.lgamma(0.5 * (n + 2.0)) - math.lgamma(0.5 * (n + 3.0)))
+    else:
+        tc = np.arccos(phimax / q)
+        M = 0.0
+        for i in range(nodes.shape[0]):
+            t = tc + (0.5 * PI - tc) * nodes[i]
+            M += weights[i] * np.cos(t) ** (n + 1.0)
+        M *= 0.5 * PI - tc
     lin = 0.25 * PI - 0.5 * tc - 0.25 * np.sin(2.0 * tc)
     Fs = KT * phimax - Rp * phimax**n  # the backbone at phi_max
     I = Fs * np.sin(tc) + KT * q * lin - Rp * q**n * M
