@@ -399,9 +399,9 @@ two processes on two cores. A shorter chain would change the intervals; it was n
 evaluations of K_z, one of them the bracket's nearer end evaluated a second time; the root now keeps each end's
 residual, slope and K_z (bit-identical). The non-Masing joint's share of its elastic backbone took M =
 int cos^(chi+3) t dt by 16 Gauss-Legendre powers at every evaluation; in microslip it is Wallis' integral, two
-lgamma (residuals move by <= 1.4e-6, on residuals of order 1-30). 16 parameter sets of the pair's objective:
-46 -> 26 ms. The 23 kept campaigns (`--keep` of the runs above) rediagnosed one at a time, the machine
-otherwise idle: every name, confidence and E before and after as before (to 4 decimals). Stage times, before
+lgamma (residuals move by <= 1.4e-6, on residuals of order 1-30). 16 parameter sets of the pair's objective,
+two runs each on the quiet machine: 34-43 -> 14-22 ms. The 23 kept campaigns (`--keep` of the runs above)
+rediagnosed one at a time, the machine otherwise idle: every name, confidence and E before and after as before (to 4 decimals). Stage times, before
 (mostly d1a2d4b or earlier, some under load) -> now:
 
     pair (elastic + cubic) voltage    seeds 1-3: 384 (load), 186, 123 -> 101, 74, 87 s
