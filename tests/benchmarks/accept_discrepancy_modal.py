@@ -427,6 +427,27 @@ And the force rig end to end, seed 1 (this script, `--ref force --seeds 1`, alon
 
 The real UNESP beam (`pytest -m acceptance tests/workflow/test_real_records.py`): unexplained (low), E 9.36 ->
 8.15 as before, the stage 36 s (43-44 s before).
+
+The force rig's seeds 2-3 end to end on 821cddf (`--ref force --seeds 2,3`, alone on the machine, 09:47-10:08):
+every row recorded before is the same but cubic_stiffening seed 2's E before (10.58; 10.81 in the matrix of
+2026-11-26, before the read-out changes since); the stage at most 48 s:
+
+    none                                 force    seed 2: none                                 high   E   0.85 ->  0.58 ( -32%) floor 0.25 stage 31 s
+    none                                 force    seed 3: none                                 high   E   0.61 ->  0.59 (  -5%) floor 0.26 stage 29 s
+    elastic_softening                    force    seed 2: elastic_softening                    high   E   5.64 ->  0.69 ( -88%) floor 0.34 stage 40 s
+    elastic_softening                    force    seed 3: elastic_softening                    high   E   9.06 ->  0.69 ( -92%) floor 0.36 stage 47 s
+    cubic_stiffening                     force    seed 2: cubic_stiffening                     high   E  10.58 ->  0.57 ( -95%) floor 0.24 stage 48 s
+    cubic_stiffening                     force    seed 3: cubic_stiffening                     high   E  10.79 ->  0.58 ( -95%) floor 0.25 stage 44 s
+    neighbour_mode                       force    seed 2: neighbour_mode                       high   E 114.42 ->  1.63 ( -99%) floor 0.18 stage 47 s
+    neighbour_mode                       force    seed 3: neighbour_mode                       high   E 102.72 ->  1.59 ( -98%) floor 0.16 stage 41 s
+    joint_settling                       force    seed 2: joint_settling                       high   E   9.86 ->  0.58 ( -94%) floor 0.25 stage 45 s
+    joint_settling                       force    seed 3: joint_settling                       high   E   9.83 ->  0.59 ( -94%) floor 0.27 stage 44 s
+    channel_delay                        force    seed 2: channel_delay                        high   E  33.20 ->  0.66 ( -98%) floor 0.25 stage 37 s
+    channel_delay                        force    seed 3: channel_delay                        high   E  32.96 ->  0.66 ( -98%) floor 0.26 stage 39 s
+    elastic_softening+cubic_stiffening   force    seed 2: cubic_stiffening                     high   E   9.37 ->  0.89 ( -91%) floor 0.33 stage 40 s
+    elastic_softening+cubic_stiffening   force    seed 3: cubic_stiffening                     high   E   9.93 ->  0.86 ( -91%) floor 0.36 stage 47 s
+    contact_spring                       force    seed 2: unexplained                          low    E  22.18 -> 11.39 ( -49%) floor 0.50 stage 41 s
+    contact_spring                       force    seed 3: unexplained                          low    E  22.31 -> 11.41 ( -49%) floor 0.52 stage 42 s
 """
 import argparse
 import json
