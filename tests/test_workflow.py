@@ -49,6 +49,32 @@ def test_an_edit_of_measure_peaks_changes_no_stage_hash_before_modal(tmp_path, m
     assert _workflow.stage_hash(SCRIPTS / "modal.py") != hashes["modal.py"]  # the hash does see the edit
 
 
+def test_every_stage_hashed_in_one_pass_is_the_sha256_of_its_own_sources(tmp_path, monkeypatch):
+    """common.smk hashes every script in one pass (`stage_hashes`, the files they share read once): each hash is
+    the SHA-256 of that script's own sources, path and text, computed here file by file; on a copy of the package
+    an edit of a module one stage imports changes that stage's hash and no other's."""
+    import hashlib
+
+    pkg = tmp_path / "jointcal"
+    shutil.copytree(REPO / "src" / "jointcal", pkg, ignore=shutil.ignore_patterns("__pycache__"))
+    monkeypatch.setattr(_workflow, "_ROOT", pkg.resolve())
+    scripts = sorted(SCRIPTS.glob("*.py"))
+
+    def by_hand(script):
+        h = hashlib.sha256()
+        for f in stage_sources(script):
+            rel = f.relative_to(pkg.resolve()).as_posix() if f.is_relative_to(pkg.resolve()) else f.name
+            h.update(rel.encode() + b"\0" + f.read_bytes() + b"\0")
+        return h.hexdigest()[:16]
+
+    before = _workflow.stage_hashes(scripts)
+    assert before == [by_hand(s) for s in scripts] and len(set(before)) == len(scripts)
+    _edit(pkg / "design" / "candidates.py")  # the design stage's alone
+    after = dict(zip((s.name for s in scripts), _workflow.stage_hashes(scripts)))
+    changed = {n for n, h in zip((s.name for s in scripts), before) if after[n] != h}
+    assert changed == {"design.py"}
+
+
 def test_typo_in_a_nested_key_names_the_nearest_valid_key():
     config = {"raw_data": "raw_data", "calibrate": {"bounds": {"Fs": [1, 10]}, "populaton": 40}}
     msg = config_problem(config, SCHEMA)

@@ -9,7 +9,7 @@ from pathlib import Path
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
-from jointcal._workflow import campaign_index, config_problem, modal_units, pending_outputs, stage_hash, unit_outputs
+from jointcal._workflow import campaign_index, config_problem, modal_units, pending_outputs, stage_hashes, unit_outputs
 from jointcal.io import write_bytes_atomic
 
 # Config: an unknown key (a typo) is one line naming the nearest valid key, before the schema's own
@@ -20,6 +20,8 @@ if problem := config_problem(config, SCHEMA):
 validate(config, SCHEMA)
 
 SCRIPTS = Path(workflow.current_basedir).parent / "scripts"
+_SCRIPT_FILES = sorted(SCRIPTS.glob("*.py"))
+SOURCE_HASHES = dict(zip((f.name for f in _SCRIPT_FILES), stage_hashes(_SCRIPT_FILES)))  # every stage's, in one pass
 
 
 def source_hash(script):
@@ -28,7 +30,7 @@ def source_hash(script):
     Passed as a rule's params, so a change to the code a stage runs reruns that stage and its
     descendants (Snakemake's params trigger); a package version nobody bumps would not.
     """
-    return stage_hash(SCRIPTS / script)
+    return SOURCE_HASHES[script]
 
 
 RAW_DATA = Path(config["raw_data"])
