@@ -448,6 +448,29 @@ every row recorded before is the same but cubic_stiffening seed 2's E before (10
     elastic_softening+cubic_stiffening   force    seed 3: cubic_stiffening                     high   E   9.93 ->  0.86 ( -91%) floor 0.36 stage 47 s
     contact_spring                       force    seed 2: unexplained                          low    E  22.18 -> 11.39 ( -49%) floor 0.50 stage 41 s
     contact_spring                       force    seed 3: unexplained                          low    E  22.31 -> 11.41 ( -49%) floor 0.52 stage 42 s
+
+A seed none of the rows above used, both rigs end to end on 64c0d34 (`--ref force --seeds 4` and `--ref voltage
+--seeds 4` side by side, 10:55-11:12, so each stage time is that of one core shared with the other run): every
+effect named, confidence high, E down 79-99%; none named none; contact unexplained; the pair named both on the
+voltage rig and the cubic alone on the force rig, as with seeds 1-3. The voltage pair's stage took 121 s beside
+the other run:
+
+    none                                 force    seed 4: none                                 high   E   0.58 ->  0.57 (  -1%) floor 0.25 stage 53 s
+    elastic_softening                    force    seed 4: elastic_softening                    high   E   9.01 ->  0.65 ( -93%) floor 0.34 stage 71 s
+    cubic_stiffening                     force    seed 4: cubic_stiffening                     high   E  10.82 ->  0.56 ( -95%) floor 0.25 stage 93 s
+    neighbour_mode                       force    seed 4: neighbour_mode                       high   E 120.72 ->  1.80 ( -99%) floor 0.18 stage 77 s
+    joint_settling                       force    seed 4: joint_settling                       high   E   9.87 ->  0.58 ( -94%) floor 0.25 stage 80 s
+    channel_delay                        force    seed 4: channel_delay                        high   E  33.07 ->  0.68 ( -98%) floor 0.24 stage 72 s
+    elastic_softening+cubic_stiffening   force    seed 4: cubic_stiffening                     high   E   9.38 ->  0.88 ( -91%) floor 0.33 stage 74 s
+    contact_spring                       force    seed 4: unexplained                          low    E  19.44 -> 11.40 ( -41%) floor 0.36 stage 56 s
+    none                                 voltage  seed 4: none                                 high   E   1.35 ->  0.64 ( -53%) floor 0.20 stage 61 s
+    elastic_softening                    voltage  seed 4: elastic_softening                    high   E   5.97 ->  0.68 ( -89%) floor 0.23 stage 79 s
+    cubic_stiffening                     voltage  seed 4: cubic_stiffening                     high   E   9.17 ->  0.63 ( -93%) floor 0.20 stage 93 s
+    neighbour_mode                       voltage  seed 4: neighbour_mode                       high   E  43.38 ->  0.44 ( -99%) floor 0.09 stage 105 s
+    joint_settling                       voltage  seed 4: joint_settling                       high   E   7.13 ->  0.66 ( -91%) floor 0.20 stage 104 s
+    channel_delay                        voltage  seed 4: channel_delay                        high   E   4.19 ->  0.89 ( -79%) floor 0.20 stage 62 s
+    elastic_softening+cubic_stiffening   voltage  seed 4: cubic_stiffening+elastic_softening   high   E   7.32 ->  0.67 ( -91%) floor 0.24 stage 121 s
+    contact_spring                       voltage  seed 4: unexplained                          low    E  16.45 ->  7.80 ( -53%) floor 0.24 stage 68 s
 """
 import argparse
 import json
