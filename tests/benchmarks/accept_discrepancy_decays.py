@@ -317,6 +317,24 @@ above: Ministack quadratic_damping seed 1 3.51 -> 0.79, high; beam elastic_softe
     ministack channel_delay                        seed 1: none                                 high   E   1.09 ->  0.72
     ministack channel_delay                        seed 2: none                                 high   E   1.10 ->  0.76
     ministack channel_delay                        seed 3: none                                 high   E   1.11 ->  0.72
+
+A seed none of the rows above used, on main 64c0d34 (`--seeds 4`, the beam and the Ministack side by side,
+2026-11-27 11:29-11:40): the right name in 11 of 11 (a pair, cubic + elastic, named both), high in 10, medium
+in joint_settling (as seed 3 above); E falls 54-94% where an effect is hidden; k3 within 9% of the truth, the
+loss ratio within 7%, c2 1.2. The beam, then the Ministack:
+
+    none s4: none high E 0.84 -> 0.78 ( -6%) floor 0.01 ok stage 53 s
+    cubic_stiffening s4: cubic_stiffening high E 9.49 -> 1.24 ( -87%) floor 0.07 ok k3 4.02e+08 (truth 3.68e+08) stage 30 s
+    elastic_softening s4: elastic_softening high E 6.16 -> 1.03 ( -83%) floor 0.02 ok loss_ratio 0.285 (truth 0.3) stage 30 s
+    joint_settling s4: joint_settling medium E 11.69 -> 0.75 ( -94%) floor 0.02 ok Fs_drift 0.18 (truth 0.15); KT_drift 0.0668 (truth 0.1); n_settle 2.83 stage 29 s
+    channel_delay s4: none high E 0.84 -> 0.79 ( -6%) floor 0.00 ok stage 54 s
+    elastic_softening+cubic_stiffening s4: cubic_stiffening+elastic_softening high E 7.69 -> 0.71 ( -91%) floor 0.27 ok k3 3.6e+08 (truth 3.68e+08); loss_ratio 0.32 (truth 0.3) stage 47 s
+
+    none s4: none high E 1.17 -> 0.84 ( -28%) floor 0.01 ok stage 44 s
+    cubic_stiffening s4: cubic_stiffening high E 1.81 -> 0.83 ( -54%) floor 0.03 ok k3 4.79e+11 (truth 5e+11) stage 105 s
+    cubic_stiffening s4: cubic_stiffening high E 2.75 -> 0.80 ( -71%) floor 0.02 ok k3 1.96e+12 (truth 2e+12) stage 57 s
+    quadratic_damping s4: quadratic_damping high E 6.44 -> 0.72 ( -89%) floor 0.02 ok c2 1.2 stage 99 s
+    channel_delay s4: none high E 1.16 -> 0.82 ( -29%) floor 0.01 ok stage 49 s
 """
 import argparse
 import sys
