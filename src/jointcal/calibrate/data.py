@@ -74,8 +74,11 @@ class ModalData:
         ring-down's k windows 1/k each: `jointcal.calibrate._readouts`); None: 1 each.
     sigma : (ndarray, ndarray), each shape (N,), or None -- each point's own relative standard error of f
         and of zeta (a ring-down window's read-out, floored as the validation floors it:
-        `jointcal.measure.testkinds.ringdown.window_scales`); set only when every point has them (a
-        campaign of ring-downs alone, read with backbone.csv's ``f_se_hz`` and ``zeta_se``), None otherwise.
+        `jointcal.measure.testkinds.ringdown.window_scales`); set when every point has them (a campaign
+        of ring-downs alone, read with backbone.csv's ``f_se_hz`` and ``zeta_se``), and in a campaign of test
+        kinds alone (ring-downs and dwells, no sweep) where some points have them: a level of dwells' phase
+        resonance, which has none, then carries the noise floors (`floors`); None otherwise (sweeps keep
+        eq. 3.9's relative errors).
     q_top : ndarray, shape (N,), or None -- with `sigma`: the amplitude at each window's start, in (the
         largest its read-out spans).
 
@@ -206,6 +209,7 @@ def select_modal(modal: pd.DataFrame, assembly: str, *, damping: Damping = "zeta
     level_col = level_column(rows.columns)
     level = (np.full(len(rows), np.nan) if level_col is None
              else pd.to_numeric(rows[level_col], errors="coerce").to_numpy(float))
+    floors = {"frequency": 1e-4, "damping": 0.01, **(floors or {})}
     run_id, weight, sigma, q_top = tuple(map(str, rows["run_id"])), None, None, None
     method = rows["f_res_method"].astype(str) if "f_res_method" in rows else pd.Series([], dtype=str)
     if backbone is not None and method.isin(methods()).any():  # a test kind's read-outs: its points in backbone
@@ -217,10 +221,12 @@ def select_modal(modal: pd.DataFrame, assembly: str, *, damping: Damping = "zeta
         notes += more
         run_id, level, weight = tuple(map(str, pts["run_id"])), pts["level"], pts["weight"]
         own = np.isfinite(pts["sigma_f"]) & np.isfinite(pts["sigma_zeta"]) & np.isfinite(pts["q_top"])
-        if own.all():  # every point a window with its own standard errors: the polish's scale (`calibrate.fit`)
-            sigma, q_top = (pts["sigma_f"], pts["sigma_zeta"]), pts["q_top"]
+        if own.all() or (own.any() and method.isin(methods()).all()):  # the polish's scale (`calibrate.fit`):
+            # the windows' own standard errors; a level of dwells' phase resonance (test kinds alone) at the floors
+            sigma = (np.where(own, pts["sigma_f"], floors["frequency"]), np.where(own, pts["sigma_zeta"],
+                                                                                  floors["damping"]))
+            q_top = np.where(own, pts["q_top"], pts["q"])
         values = {"q_in": pts["q"], FREQUENCY: pts["f"], damping: pts["zeta"]}
-    floors = {"frequency": 1e-4, "damping": 0.01, **(floors or {})}
     noise = (float("nan"), float("nan"))
     if scatter is not None:
         missing = [c for c in _SCATTER_COLUMNS if c not in scatter.columns]

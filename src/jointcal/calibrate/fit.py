@@ -14,7 +14,10 @@ result wins. `ga_best.json` reports both the GA's own best (``objective_ga``) an
 polished one (``objective``).
 
 **Points with their own standard errors** (a campaign of ring-downs alone: every point a window whose
-read-out gives its standard errors, `ModalData.sigma`): the GA still searches on eq. 3.9, but the polish
+read-out gives its standard errors, `ModalData.sigma`; or of ring-downs and dwells alone, a level of dwells'
+phase resonance then at the noise floors, 1e-4 in f and 0.01 in zeta: on the real UNESP beam's five dwells and
+their decays, 2026-11-27, the validation's E 78.2 with eq. 3.9's polish, 11.7 on this scale, E_f 138 -> 19):
+the GA still searches on eq. 3.9, but the polish
 refines on the residuals over those standard errors, the likelihood's scale and the validation's
 (`jointcal.validate.decay`: each window judged on its own standard error),
 
