@@ -33,6 +33,10 @@ def _break(tmp_path, edit):
 @pytest.mark.parametrize("edit, message", [
     (lambda d: d.pop("q_in"), "column(s) q_in missing"),
     (lambda d: d.__setitem__("flags", "unusable"), "all 12 runs of assembly 'first' are flagged unusable"),
+    # every run unusable and no read-out column at all (the modal stage read nothing, e.g. force-driven dwells with
+    # the shaker left on and no sweep): the runs are what to fix, not the table
+    (lambda d: [d.__setitem__("flags", "shaker_on;unusable"), *(d.pop(c) for c in ("q_in", "f_res_hz", "zeta_res"))],
+     "all 12 runs of assembly 'first' are flagged unusable"),
     (lambda d: d.__setitem__("zeta_res", np.nan), "set calibrate.damping to zeta_phase_resonance"),
     (lambda d: d.__setitem__("assembly", "other"), "no runs of assembly 'first'"),
 ])

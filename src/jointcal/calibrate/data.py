@@ -40,6 +40,7 @@ Damping = Literal["zeta_res", "zeta_phase_resonance", "zeta_half_power"]
 DAMPING: tuple[str, ...] = ("zeta_res", "zeta_phase_resonance", "zeta_half_power")
 FREQUENCY = "f_res_hz"
 _MODAL_COLUMNS = ("run_id", "assembly", "q_in", FREQUENCY, "flags")
+_READOUT_COLUMNS = ("q_in", FREQUENCY)
 _SCATTER_COLUMNS = ("assembly", "quantity", "source", "rel_std")
 BACKBONE_COLUMNS = ("run_id", "mode", "test", "q_in", "f_hz", "zeta")  # jointcal.measure.testkinds
 
@@ -172,11 +173,16 @@ def select_modal(modal: pd.DataFrame, assembly: str, *, damping: Damping = "zeta
     """
     if damping not in DAMPING:
         raise ValueError(f"damping must be one of {', '.join(DAMPING)}, got {damping!r}")
-    need = [*_MODAL_COLUMNS, damping]
-    missing = [c for c in need if c not in modal.columns]
-    if missing:
-        _fail(modal_name, f"column(s) {', '.join(missing)} missing (found: {', '.join(map(str, modal.columns))})",
-              "regenerate it with the modal stage")
+
+    def _need(columns) -> None:
+        missing = [c for c in columns if c not in modal.columns]
+        if missing:
+            _fail(modal_name, f"column(s) {', '.join(missing)} missing (found: "
+                  f"{', '.join(map(str, modal.columns))})", "regenerate it with the modal stage")
+
+    # the read-outs' columns after the flags: a table whose every run is unusable may have none of them (the modal
+    # stage read nothing), and what to fix is then the runs, which the modal log names
+    _need([c for c in _MODAL_COLUMNS if c not in _READOUT_COLUMNS])
     rows = modal[modal["assembly"].astype(str) == str(assembly)]
     if rows.empty:
         found = ", ".join(sorted(map(str, modal["assembly"].unique()))) or "none"
@@ -186,7 +192,9 @@ def select_modal(modal: pd.DataFrame, assembly: str, *, damping: Damping = "zeta
     notes = [f"{modal_name}: {int((~keep).sum())} of {len(rows)} runs of {assembly!r} flagged unusable, left out"]
     if not keep.any():
         _fail(modal_name, f"all {len(rows)} runs of assembly {assembly!r} are flagged unusable",
-              "fix the flagged runs or the modal settings; nothing is left to calibrate")
+              "fix the flagged runs or the modal settings (the modal stage's log says why each run was flagged); "
+              "nothing is left to calibrate")
+    _need([*_READOUT_COLUMNS, damping])
     rows = rows[keep]
     finite = np.ones(len(rows), bool)
     for col in ("q_in", FREQUENCY, damping):
